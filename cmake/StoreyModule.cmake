@@ -1,0 +1,36 @@
+# storey_module(<target> DIR <folder> [DEPS <libs...>] [EXCLUDE <regex>])
+# One library target per top-level folder, built from every .cpp beneath it, so that adding a
+# file never means editing CMake. Includes are rooted at the repository ("rt/spsc_queue.hpp").
+function(storey_module target)
+  cmake_parse_arguments(M "" "DIR;EXCLUDE" "DEPS" ${ARGN})
+  file(GLOB_RECURSE srcs CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/${M_DIR}/*.cpp
+       ${PROJECT_SOURCE_DIR}/${M_DIR}/*.c)
+  if(M_EXCLUDE)
+    list(FILTER srcs EXCLUDE REGEX "${M_EXCLUDE}")
+  endif()
+  if(srcs)
+    add_library(${target} STATIC ${srcs})
+    target_include_directories(${target} PUBLIC ${PROJECT_SOURCE_DIR} ${PROJECT_BINARY_DIR}/generated)
+    target_link_libraries(${target} PUBLIC ${M_DEPS})
+  else()
+    add_library(${target} INTERFACE)
+    target_include_directories(${target} INTERFACE ${PROJECT_SOURCE_DIR})
+    target_link_libraries(${target} INTERFACE ${M_DEPS})
+  endif()
+endfunction()
+
+# storey_test_dir(<name> LIBS <libs...> [LABELS <labels...>])
+# Builds every .cpp in the calling folder into one GoogleTest executable test_<name>.
+function(storey_test_dir name)
+  cmake_parse_arguments(T "" "" "LIBS;LABELS" ${ARGN})
+  file(GLOB srcs CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*.cpp)
+  if(NOT srcs)
+    return()
+  endif()
+  add_executable(test_${name} ${srcs})
+  target_link_libraries(test_${name} PRIVATE ${T_LIBS} GTest::gtest GTest::gtest_main GTest::gmock)
+  target_compile_definitions(test_${name} PRIVATE STOREY_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
+                             STOREY_BINARY_DIR="${PROJECT_BINARY_DIR}")
+  set(labels unit ${T_LABELS})
+  gtest_discover_tests(test_${name} PROPERTIES LABELS "${labels}" DISCOVERY_TIMEOUT 60)
+endfunction()

@@ -1,0 +1,21 @@
+#pragma once
+// The verbs of the storey executable. Each returns a process exit code: 0 success,
+// 1 the work failed, 2 bad usage or bad input (with a one-line reason on stderr).
+#include <span>
+
+namespace storey::firmware {
+
+inline constexpr const char* kVersion = "0.1.0";
+
+struct Command {
+  const char* name;
+  const char* summary;
+  int (*run)(int argc, char** argv);  // argv[0] is the verb itself
+};
+
+std::span<const Command> commands();
+
+int cmd_self_check(int argc, char** argv);
+int cmd_check_config(int argc, char** argv);
+
+}  // namespace storey::firmware
