@@ -21,7 +21,7 @@ class CanOverUdpTransport final : public CanTransport {
   CanIoStatus send(const CanFrame& f) override;
   CanIoStatus receive(CanFrame& f) override;
   CanTransportStats stats() const override { return stats_; }
-  uint16_t local_port() const { return socket_.local_port(); }
+  uint16_t local_port() const override { return socket_.local_port(); }
 
   static constexpr int kMaxFilters = 16;
 

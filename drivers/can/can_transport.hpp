@@ -46,6 +46,8 @@ class CanTransport {
   // Non-blocking: ok (frame filled), empty, bus_off, error or malformed.
   virtual CanIoStatus receive(CanFrame& f) = 0;
   virtual CanTransportStats stats() const = 0;
+  // Bound UDP port for UDP-based transports (tests bind port 0); 0 otherwise.
+  virtual uint16_t local_port() const { return 0; }
 };
 
 }  // namespace storey::drivers::can

@@ -33,6 +33,7 @@ class CanChannel final : public MessageChannel {
   RxStatus receive(ChannelMessage& out) override;
   void add_transport_health(LinkHealth& h) const override;
   can::CanTransport& transport() { return *transport_; }
+  uint16_t local_port() const override { return transport_ ? transport_->local_port() : 0; }
 
  private:
   Role role_;

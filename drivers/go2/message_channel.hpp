@@ -41,6 +41,8 @@ class MessageChannel {
   virtual RxStatus receive(ChannelMessage& out) = 0;
   // Adds transport counters (kernel drops, bus errors, reopens) into `h`.
   virtual void add_transport_health(LinkHealth& h) const { (void)h; }
+  // Bound UDP port where the transport is UDP-based (tests bind port 0); 0 otherwise.
+  virtual uint16_t local_port() const { return 0; }
 };
 
 }  // namespace storey::drivers::go2

@@ -49,6 +49,7 @@ struct LinkHealth {
   uint64_t invalid_commands_refused = 0;
   uint64_t send_errors = 0;
   uint64_t commands_sent = 0;
+  uint64_t commands_rejected = 0;  // DDS: responses with a non-zero status code
   uint64_t rx_overflow_drops = 0;  // kernel receive-queue drops where the transport reports them
   uint64_t bus_errors = 0;         // CAN error frames
   uint64_t bus_off_events = 0;     // CAN bus-off

@@ -16,7 +16,7 @@ class UdpChannel final : public MessageChannel {
   const char* error() const override { return socket_.error().c_str(); }
   LinkStatus send(const FrameHeader& h, const uint8_t* payload, size_t len) override;
   RxStatus receive(ChannelMessage& out) override;
-  uint16_t local_port() const { return socket_.local_port(); }
+  uint16_t local_port() const override { return socket_.local_port(); }
 
  private:
   Role role_;
