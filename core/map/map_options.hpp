@@ -1,22 +1,37 @@
 #pragma once
 // Parameters of the traversability-aware volumetric map (paper Sec. III-A).
+// Units are in every name; paper symbols in the comments.
 namespace storey::core::map {
 
 struct MapOptions {
-  double voxel_size_m = 0.1;        // map resolution
-  double max_range_m = 30.0;        // rays beyond this are truncated (free space only)
-  double min_range_m = 0.3;         // returns closer than this are dropped (robot body)
-  float log_odds_hit = 0.85f;       // log-odds added to an endpoint voxel
-  float log_odds_miss = -0.4f;      // log-odds added to a voxel a ray passes through
-  float log_odds_min = -2.0f;       // clamping
+  // --- occupancy (ray casting) ---
+  double voxel_size_m = 0.1;    // map resolution
+  double max_range_m = 30.0;    // rays beyond this are truncated (free space only, no endpoint)
+  double min_range_m = 0.3;     // returns closer than this are dropped (robot body)
+  float log_odds_hit = 0.85f;   // log-odds added to an endpoint voxel (once per scan)
+  float log_odds_miss = -0.4f;  // log-odds added to a voxel a ray passes through (once per scan)
+  float log_odds_min = -2.0f;   // clamping (keeps the map able to change)
   float log_odds_max = 3.5f;
-  float log_odds_occupied = 0.0f;   // occupied above this
-  int n_min = 5;                    // N_min, Eq. 3: fewer points -> S_unobs
-  double neighbourhood_radius_m = 0.2;  // aggregation radius for Eq. 1
-  double w_s = 1.0;                 // w_s, Eq. 2 slope weight
-  double w_r = 0.5;                 // w_r, Eq. 2 roughness weight
-  double w_u = 0.3;                 // w_u, Eq. 2 under-observation weight
-  double tau_c = 0.8;               // tau_c, Eq. 3 maximum terrain cost
+  float log_odds_occupied = 0.0f;  // occupied above this
+  // --- terrain statistics, Eq. 1-3 ---
+  int n_min = 5;                        // N_min, Eq. 3: fewer points in v -> S_unobs
+  double neighbourhood_radius_m = 0.2;  // aggregation radius for Eq. 1 (horizontal)
+  double neighbourhood_dz_m = 0.1;      // aggregation keeps support voxels within this height of v
+                                        // (so stair treads are not blended with the next tread)
+  int n_ref = 40;                       // u(v) = 1 - min(1, N_agg / n_ref): under-observation
+  double w_s = 1.0;                     // w_s, Eq. 2 slope weight (s_bar = s / max_slope)
+  double w_r = 0.5;                     // w_r, Eq. 2 roughness weight (r_bar = r, already in [0,1])
+  double w_u = 0.3;                     // w_u, Eq. 2 under-observation weight (u_bar = u)
+  double tau_c = 1.0;                // tau_c, Eq. 3 maximum terrain cost; 1.0 so that slope alone
+                                     // reaches it exactly at RobotModel::max_slope_rad
+  double fall_support_ratio = 0.75;  // R_fall: fewer supported neighbour columns than this
+                                     // fraction within neighbourhood_radius_m -> fall risk
+  double collision_radius_m = 0.1;   // R_col: horizontal radius of the clearance column above v
+  // --- reachable set ---
+  double seed_search_radius_m = 1.0;  // robot support voxel: nearest traversable within this
+                                      // (the LiDAR cannot see under the body, min_range_m)
+  // --- limits (bad input) ---
+  double world_limit_m = 100000.0;  // points/origins with |coordinate| beyond this are dropped
 };
 
 }  // namespace storey::core::map

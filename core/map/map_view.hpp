@@ -1,0 +1,138 @@
+#pragma once
+// Read-only queries on the traversability map (paper Sec. III-A), used by the reachable graph,
+// frontiers, viewpoints, A* and the FCL look-ahead. A MapView is a pair of references: over a
+// MapSnapshot it is valid as long as the snapshot lives (any thread); over the live map it is
+// valid only on the owner thread and only until the next mutating call on the map.
+#include <cmath>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/map/block_store.hpp"
+#include "core/map/map_options.hpp"
+#include "core/map/voxel_block.hpp"
+#include "core/robot_model.hpp"
+
+namespace storey::core::map {
+
+// Caches the last block looked up. Invalidation: holds a raw pointer into `store`; it must not
+// outlive a write to `store` (the owner's copy-on-write may swap the block behind a key).
+// Every MapView query builds its own BlockReader, so views never hold stale pointers.
+class BlockReader {
+ public:
+  explicit BlockReader(const BlockStore& store) : store_(&store) {}
+  const VoxelBlock* block(const VoxelKey& k) {
+    const uint64_t bk = block_key_of(k);
+    if (bk != key_ || !valid_) {
+      key_ = bk;
+      block_ = store_->find(bk);
+      valid_ = true;
+    }
+    return block_;
+  }
+  const Cell* cell(const VoxelKey& k) {
+    const VoxelBlock* b = block(k);
+    return b ? &b->cells[cell_index(k)] : nullptr;
+  }
+  // Statistics of k, or nullptr if it has none.
+  const VoxelStats* stats(const VoxelKey& k) {
+    const VoxelBlock* b = block(k);
+    if (!b) return nullptr;
+    const Cell& c = b->cells[cell_index(k)];
+    return c.stats == Cell::kNoStats ? nullptr : &b->stats[c.stats];
+  }
+  void invalidate() { valid_ = false; }
+
+ private:
+  const BlockStore* store_;
+  uint64_t key_ = 0;
+  const VoxelBlock* block_ = nullptr;
+  bool valid_ = false;
+};
+
+// A support voxel found near a query point.
+struct SurfacePoint {
+  VoxelKey key;
+  float height_m = 0;  // surface height: mean z of the voxel's points [m]
+  TravState state = TravState::kNone;
+  bool reachable = false;  // member of C_reach
+};
+
+class MapView {
+ public:
+  MapView(const BlockStore& store, const MapOptions& options, const RobotModel& robot)
+      : store_(&store), opt_(&options), robot_(&robot) {}
+
+  double voxel_size_m() const { return opt_->voxel_size_m; }
+  VoxelKey key_of(const Eigen::Vector3f& p_m) const;
+  Eigen::Vector3f centre_of(const VoxelKey& k) const;
+
+  // Occupancy from log-odds: unknown (never observed), free, occupied.
+  Occupancy occupancy(const VoxelKey& k) const;
+  Occupancy occupancy(const Eigen::Vector3f& p_m) const { return occupancy(key_of(p_m)); }
+  bool is_occupied(const VoxelKey& k) const { return occupancy(k) == Occupancy::kOccupied; }
+  // Support voxel: occupied, and the voxel directly above is not occupied.
+  bool is_support(const VoxelKey& k) const;
+  TravState state(const VoxelKey& k) const;  // tau(v), Eq. 3 (kNone if not occupied)
+  bool is_traversable(const VoxelKey& k) const { return state(k) == TravState::kTraversable; }
+  bool is_reachable(const VoxelKey& k) const;     // v in C_reach
+  uint32_t point_count(const VoxelKey& k) const;  // N(v)
+  float cost(const VoxelKey& k) const;            // c(v), Eq. 2 (0 if never evaluated)
+  // Surface height of an occupied voxel: centre z + mean of its points [m].
+  std::optional<float> surface_height_m(const VoxelKey& k) const;
+
+  // Support surface near (x, y, z): the support voxel in the column under (x, y) whose surface
+  // height is closest to z within [z - window_m, z + window_m]; nullopt if none (I(x, z) = 0 in
+  // the paper's missing-surface ratio, Eq. 5).
+  std::optional<SurfacePoint> support_surface_near(const Eigen::Vector3f& p_m,
+                                                   double window_m) const;
+
+  // Visibility: the first occupied voxel on the segment from -> to (excluding the voxel of
+  // `from`), nullopt if none.
+  std::optional<VoxelKey> first_occupied(const Eigen::Vector3f& from_m,
+                                         const Eigen::Vector3f& to_m) const;
+  // True if no voxel on the segment is occupied (and, unless unknown_is_free, none is unknown).
+  bool is_segment_free(const Eigen::Vector3f& from_m, const Eigen::Vector3f& to_m,
+                       bool unknown_is_free) const;
+  // Probe for frontiers: walks from -> to and reports the first non-free voxel's occupancy
+  // (kFree if the whole segment is known free). `hit` receives that voxel if given.
+  Occupancy probe(const Eigen::Vector3f& from_m, const Eigen::Vector3f& to_m,
+                  VoxelKey* hit = nullptr) const;
+  // Free space above a surface voxel: the voxels from k.z+1 up to height_m above the surface
+  // are not occupied (and known, unless unknown_is_free). For A* through the free voxels above
+  // the traversable surface (paper Sec. IV-D, Stage 3).
+  bool is_free_above(const VoxelKey& k, double height_m, bool unknown_is_free) const;
+  // Centres of the occupied voxels in the axis-aligned box centre +- half_extent (for FCL
+  // checks of the body against the map). Appends to `out`; returns how many were appended.
+  size_t occupied_in_box(const Eigen::Vector3f& centre_m, const Eigen::Vector3f& half_extent_m,
+                         std::vector<Eigen::Vector3f>& out) const;
+
+  // Iterate occupied voxels: f(key, cell, stats*).
+  template <class F>
+  void for_each_occupied(F&& f) const {
+    const int16_t occ = int16_t(std::lround(opt_->log_odds_occupied * kLogOddsScale));
+    store_->for_each([&](const VoxelBlock& b) {
+      for (int i = 0; i < kBlockCells; ++i) {
+        const Cell& c = b.cells[i];
+        if (!(c.flags & Cell::kObserved) || c.log_odds <= occ) continue;
+        const VoxelKey k{(b.bx << kBlockBits) | (i >> (2 * kBlockBits)),
+                         (b.by << kBlockBits) | ((i >> kBlockBits) & kBlockMask),
+                         (b.bz << kBlockBits) | (i & kBlockMask)};
+        f(k, c, c.stats == Cell::kNoStats ? nullptr : &b.stats[c.stats]);
+      }
+    });
+  }
+
+  const MapOptions& options() const { return *opt_; }
+  const RobotModel& robot() const { return *robot_; }
+  const BlockStore& store() const { return *store_; }
+
+ private:
+  const BlockStore* store_;
+  const MapOptions* opt_;
+  const RobotModel* robot_;
+};
+
+}  // namespace storey::core::map

@@ -1,0 +1,251 @@
+// TraversabilityMap: the connected reachable set C_reach (paper Sec. III-A, last paragraph).
+//
+// Adjacency: two traversable support voxels in 8-connected neighbouring columns whose surface
+// heights differ by at most the step height (slope is already bounded per voxel by c(v)); any
+// number of floors can stack over one column. Maintenance is a dynamic BFS tree: every member
+// stores its hop count from the root, and every member but the root has a neighbour with a
+// smaller count. Growth adds voxels with parent count + 1. Removal (a member turned
+// untraversable or lost its edge) orphans it and, transitively, every neighbour with a larger
+// count that finds no other neighbour with a smaller one; then the orphans are regrown from
+// the surviving boundary. A full regrow from the seed happens only when the root itself is lost
+// or the robot stands on a different component.
+#include <algorithm>
+#include <limits>
+#include <unordered_set>
+
+#include "core/map/traversability_map.hpp"
+
+namespace storey::core::map {
+
+namespace {
+constexpr int kDx[8] = {1, -1, 0, 0, 1, 1, -1, -1};
+constexpr int kDy[8] = {0, 0, 1, -1, 1, -1, 1, -1};
+}  // namespace
+
+bool TraversabilityMap::connected(const VoxelKey& a, const VoxelKey& b) {
+  const Cell* ca = rcell(a);
+  if (!ca || ca->state != TravState::kTraversable) return false;
+  const float ha = surface_height(a, rstats(a));
+  const Cell* cb = rcell(b);
+  if (!cb || cb->state != TravState::kTraversable) return false;
+  return std::abs(surface_height(b, rstats(b)) - ha) <= robot_.step_height_m;
+}
+
+bool TraversabilityMap::has_parent(const VoxelKey& k, uint32_t dist) {
+  for (int i = 0; i < 8; ++i)
+    for (int dz = -dz_step_; dz <= dz_step_; ++dz) {
+      const VoxelKey w{k.x + kDx[i], k.y + kDy[i], k.z + dz};
+      const Cell* cw = rcell(w);
+      if (!cw || !(cw->flags & Cell::kReachable)) continue;
+      if (rstats(w)->reach_dist < dist && connected(k, w)) return true;
+    }
+  return false;
+}
+
+void TraversabilityMap::set_reachable(const VoxelKey& k, uint32_t dist) {
+  VoxelBlock* b = wblock(k, false);
+  Cell& c = b->cells[cell_index(k)];
+  if (!(c.flags & Cell::kReachable)) ++reach_count_;
+  c.flags |= Cell::kReachable;
+  b->stats[c.stats].reach_dist = dist;
+}
+
+void TraversabilityMap::clear_reachable(const VoxelKey& k) {
+  Cell* c = wcell(k);
+  if (c && (c->flags & Cell::kReachable)) {
+    c->flags &= ~Cell::kReachable;
+    --reach_count_;
+  }
+}
+
+std::optional<VoxelKey> TraversabilityMap::find_seed(const Eigen::Vector3f& foot) {
+  const double s = opt_.voxel_size_m;
+  const int r = int(std::ceil(opt_.seed_search_radius_m / s));
+  const int32_t cx = int32_t(std::floor(foot.x() / s)), cy = int32_t(std::floor(foot.y() / s));
+  const int32_t cz = int32_t(std::floor(foot.z() / s));
+  std::optional<VoxelKey> best;
+  double best_d = std::numeric_limits<double>::infinity();
+  bool best_reach = false;
+  for (int dx = -r; dx <= r; ++dx)
+    for (int dy = -r; dy <= r; ++dy) {
+      const double d2 = double(dx * dx + dy * dy);
+      if (d2 > double(r * r)) continue;
+      for (int dz = -dz_step_ - 1; dz <= dz_step_ + 1; ++dz) {
+        const VoxelKey k{cx + dx, cy + dy, cz + dz};
+        const Cell* c = rcell(k);
+        if (!c || c->state != TravState::kTraversable) continue;
+        const double dh = surface_height(k, rstats(k)) - foot.z();
+        if (std::abs(dh) > robot_.step_height_m) continue;
+        // Prefer members of C_reach (the robot stands on the component it came from).
+        const bool reach = c->flags & Cell::kReachable;
+        const double d = d2 * s * s + dh * dh;
+        if ((reach && !best_reach) || (reach == best_reach && d < best_d)) {
+          best = k;
+          best_d = d;
+          best_reach = reach;
+        }
+      }
+    }
+  return best;
+}
+
+void TraversabilityMap::grow_bfs(ReachUpdateStats& st) {
+  for (size_t q = 0; q < grow_queue_.size(); ++q) {
+    const VoxelKey u = grow_queue_[q];
+    const uint32_t du = rstats(u)->reach_dist;
+    for (int i = 0; i < 8; ++i)
+      for (int dz = -dz_step_; dz <= dz_step_; ++dz) {
+        const VoxelKey w{u.x + kDx[i], u.y + kDy[i], u.z + dz};
+        const Cell* cw = rcell(w);
+        if (!cw || cw->state != TravState::kTraversable || (cw->flags & Cell::kReachable)) continue;
+        if (!connected(u, w)) continue;
+        set_reachable(w, du + 1);
+        grow_queue_.push_back(w);
+        ++st.grown;
+      }
+  }
+  grow_queue_.clear();
+}
+
+void TraversabilityMap::regrow_from(const VoxelKey& seed, ReachUpdateStats& st) {
+  st.full_regrow = true;
+  orphans_.clear();
+  MapView(store_, opt_, robot_)
+      .for_each_occupied([&](const VoxelKey& k, const Cell& c, const VoxelStats*) {
+        if (c.flags & Cell::kReachable) orphans_.push_back(k);
+      });
+  for (const VoxelKey& k : orphans_) clear_reachable(k);
+  st.orphaned += uint32_t(orphans_.size());
+  orphans_.clear();
+  has_root_ = true;
+  root_ = seed;
+  set_reachable(seed, 0);
+  ++st.grown;
+  grow_queue_.clear();
+  grow_queue_.push_back(seed);
+  grow_bfs(st);
+}
+
+ReachUpdateStats TraversabilityMap::update_reachable(const Eigen::Vector3f& foot) {
+  ReachUpdateStats st;
+  const std::optional<VoxelKey> seed = find_seed(foot);
+  st.has_seed = seed.has_value();
+  const Cell* root_cell = has_root_ ? rcell(root_) : nullptr;
+  if (!root_cell || root_cell->state != TravState::kTraversable) {
+    // No tree yet, or its root was lost: rebuild from the robot (or empty the set).
+    if (seed) {
+      regrow_from(*seed, st);
+    } else if (has_root_) {
+      orphans_.clear();
+      MapView(store_, opt_, robot_)
+          .for_each_occupied([&](const VoxelKey& k, const Cell& c, const VoxelStats*) {
+            if (c.flags & Cell::kReachable) orphans_.push_back(k);
+          });
+      for (const VoxelKey& k : orphans_) clear_reachable(k);
+      st.orphaned = uint32_t(orphans_.size());
+      has_root_ = false;
+    }
+    reach_changed_.clear();
+    return st;
+  }
+
+  // Decremental pass. Sources: members that changed. A member that is no longer traversable
+  // or lost every parent edge is orphaned; every source (orphaned or not, since its height may
+  // have changed) has its larger-count neighbours re-checked.
+  orphan_queue_.clear();
+  orphans_.clear();
+  for (const ReachChange& rc : reach_changed_) {
+    if (!rc.was_reachable) continue;
+    const Cell* c = rcell(rc.key);
+    if (!c || !(c->flags & Cell::kReachable)) {  // turned free, or a duplicate entry
+      orphan_queue_.push_back({rc.key, rc.old_dist});
+      continue;
+    }
+    if (rc.key == root_) {
+      orphan_queue_.push_back({rc.key, 0});
+      continue;
+    }
+    const uint32_t d = rstats(rc.key) ? rstats(rc.key)->reach_dist : rc.old_dist;
+    if (c->state != TravState::kTraversable || !has_parent(rc.key, d)) {
+      clear_reachable(rc.key);
+      orphans_.push_back(rc.key);
+      ++st.orphaned;
+    }
+    orphan_queue_.push_back({rc.key, d});
+  }
+  for (size_t q = 0; q < orphan_queue_.size(); ++q) {
+    const auto [u, du] = orphan_queue_[q];
+    for (int i = 0; i < 8; ++i)
+      for (int dz = -dz_step_; dz <= dz_step_; ++dz) {
+        const VoxelKey w{u.x + kDx[i], u.y + kDy[i], u.z + dz};
+        const Cell* cw = rcell(w);
+        if (!cw || !(cw->flags & Cell::kReachable) || w == root_) continue;
+        const uint32_t dw = rstats(w)->reach_dist;
+        if (dw <= du || has_parent(w, dw)) continue;
+        clear_reachable(w);
+        orphans_.push_back(w);
+        orphan_queue_.push_back({w, dw});
+        ++st.orphaned;
+      }
+  }
+
+  // Incremental growth: orphans and changed voxels that touch C_reach rejoin it, then BFS.
+  grow_queue_.clear();
+  auto attach = [&](const VoxelKey& k) {
+    const Cell* c = rcell(k);
+    if (!c || c->state != TravState::kTraversable || (c->flags & Cell::kReachable)) return;
+    uint32_t best = std::numeric_limits<uint32_t>::max();
+    for (int i = 0; i < 8; ++i)
+      for (int dz = -dz_step_; dz <= dz_step_; ++dz) {
+        const VoxelKey w{k.x + kDx[i], k.y + kDy[i], k.z + dz};
+        const Cell* cw = rcell(w);
+        if (!cw || !(cw->flags & Cell::kReachable) || !connected(k, w)) continue;
+        best = std::min(best, rstats(w)->reach_dist);
+      }
+    if (best == std::numeric_limits<uint32_t>::max()) return;
+    set_reachable(k, best + 1);
+    grow_queue_.push_back(k);
+    ++st.grown;
+  };
+  for (const VoxelKey& k : orphans_) attach(k);
+  for (const ReachChange& rc : reach_changed_) attach(rc.key);
+  grow_bfs(st);
+  reach_changed_.clear();
+  orphans_.clear();
+
+  // The robot walked onto a component C_reach does not contain: rebuild from there.
+  if (seed && !(rcell(*seed)->flags & Cell::kReachable)) regrow_from(*seed, st);
+  return st;
+}
+
+std::vector<VoxelKey> TraversabilityMap::grow_from_scratch(const VoxelKey& seed) const {
+  BlockReader r(store_);
+  auto trav = [&](const VoxelKey& k) {
+    const Cell* c = r.cell(k);
+    return c && c->state == TravState::kTraversable;
+  };
+  auto height = [&](const VoxelKey& k) { return surface_height(k, r.stats(k)); };
+  struct Hash {
+    size_t operator()(const VoxelKey& k) const {
+      return size_t(k.x) * 73856093u ^ size_t(k.y) * 19349663u ^ size_t(k.z) * 83492791u;
+    }
+  };
+  std::vector<VoxelKey> out;
+  if (!trav(seed)) return out;
+  std::unordered_set<VoxelKey, Hash> seen{seed};
+  out.push_back(seed);
+  for (size_t q = 0; q < out.size(); ++q) {
+    const VoxelKey u = out[q];
+    const float hu = height(u);
+    for (int i = 0; i < 8; ++i)
+      for (int dz = -dz_step_; dz <= dz_step_; ++dz) {
+        const VoxelKey w{u.x + kDx[i], u.y + kDy[i], u.z + dz};
+        if (seen.count(w) || !trav(w) || std::abs(height(w) - hu) > robot_.step_height_m) continue;
+        seen.insert(w);
+        out.push_back(w);
+      }
+  }
+  return out;
+}
+
+}  // namespace storey::core::map

@@ -1,0 +1,186 @@
+// TraversabilityMap: terrain statistics and traversability state, paper Sec. III-A Eq. 1-3.
+#include <cmath>
+
+#include <Eigen/Eigenvalues>
+
+#include "core/map/traversability_map.hpp"
+
+namespace storey::core::map {
+
+TravUpdateStats TraversabilityMap::update_traversability() {
+  TravUpdateStats st;
+  // 1. Dirty set: every occupied voxel whose tau(v) can depend on a changed voxel c, i.e. v
+  //    with c in its aggregation window (|dxy| <= r_agg, |dz| <= dz_agg), in its clearance
+  //    column or fall-support columns (c.z - v.z in [-dz_step, h_clear]).
+  const int r = std::max(r_agg_, r_col_);
+  const int up = std::max(dz_step_, dz_agg_) + 1, down = h_clear_ + 1;
+  for (const VoxelKey& c : changed_) {
+    if (Cell* cc = wcell(c)) cc->flags &= ~Cell::kChanged;
+    for (int dx = -r; dx <= r; ++dx)
+      for (int dy = -r; dy <= r; ++dy)
+        for (int32_t z = c.z - down; z <= c.z + up; ++z) {
+          const VoxelKey v{c.x + dx, c.y + dy, z};
+          const Cell* rc = rcell(v);
+          if (!rc || (rc->flags & Cell::kQueued)) continue;
+          if (!occupied(rc) && rc->state == TravState::kNone) continue;
+          wcell(v)->flags |= Cell::kQueued;
+          dirty_.push_back(v);
+        }
+  }
+  changed_.clear();
+
+  // 2. Re-evaluate. evaluate() reads only statistics and occupancy of neighbours, never their
+  //    states, so the order of the dirty set does not matter.
+  for (const VoxelKey& k : dirty_) {
+    VoxelBlock* b = wblock(k, false);
+    Cell& c = b->cells[cell_index(k)];
+    c.flags &= ~Cell::kQueued;
+    VoxelStats* s = c.stats == Cell::kNoStats ? nullptr : &b->stats[c.stats];
+    const TravState old = c.state;
+    const bool was_reach = c.flags & Cell::kReachable;
+    const uint32_t old_dist = s ? s->reach_dist : 0;
+    const TravState now = evaluate(k, s);
+    // evaluate() only reads through the read cache; re-fetch in case nothing changed.
+    b = wblock(k, false);
+    Cell& c2 = b->cells[cell_index(k)];
+    c2.state = now;
+    ++st.evaluated;
+    if (now != old) {
+      ++st.state_changes;
+      if (old == TravState::kTraversable) --trav_count_;
+      if (now == TravState::kTraversable) ++trav_count_;
+    }
+    if (now != old || now == TravState::kTraversable || was_reach)
+      reach_changed_.push_back({k, old_dist, was_reach});
+    if (now == TravState::kNone) {  // turned free: statistics are stale
+      // Members of C_reach always own statistics (reach_dist lives there); the reachable pass
+      // still sees this voxel through reach_changed_ (was_reach, old_dist).
+      if (c2.flags & Cell::kReachable) {
+        c2.flags &= ~Cell::kReachable;
+        --reach_count_;
+      }
+      b->release_stats(c2);
+    }
+  }
+  dirty_.clear();
+  return st;
+}
+
+TravState TraversabilityMap::evaluate(const VoxelKey& k, VoxelStats* s) {
+  const Cell* c = rcell(k);
+  if (!occupied(c)) return TravState::kNone;
+  if (!s || s->count < uint32_t(opt_.n_min)) {  // Eq. 3, first case
+    if (s) s->count_eval = s->count;
+    return TravState::kUnobserved;
+  }
+  s->count_eval = s->count;
+  s->reasons = 0;
+  if (occupied(rcell({k.x, k.y, k.z + 1}))) {  // not a top surface: cannot stand on it
+    s->reasons = VoxelStats::kReasonNotTop;
+    return TravState::kUntraversable;
+  }
+  const double vs = opt_.voxel_size_m;
+  const float h_v = surface_height(k, s);
+
+  // Eq. 1: aggregate the statistics of the support voxels in the neighbourhood (radius
+  // r_agg, surface height within neighbourhood_dz_m of v) in v's centre frame, in double:
+  // sums of n, n*m and M2 + n*m*m^T, then the pooled covariance.
+  double n_agg = 0;
+  Eigen::Vector3d sum_m = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d sum_s = Eigen::Matrix3d::Zero();
+  const int r2 = r_agg_ * r_agg_;
+  for (int dx = -r_agg_; dx <= r_agg_; ++dx)
+    for (int dy = -r_agg_; dy <= r_agg_; ++dy) {
+      if (dx * dx + dy * dy > r2) continue;
+      bool above_occ = occupied(rcell({k.x + dx, k.y + dy, k.z + dz_agg_ + 1}));
+      for (int dz = dz_agg_; dz >= -dz_agg_; --dz) {  // top-down: "above" is known
+        const VoxelKey w{k.x + dx, k.y + dy, k.z + dz};
+        const Cell* cw = rcell(w);
+        const bool occ = occupied(cw);
+        if (occ && !above_occ && cw->stats != Cell::kNoStats) {
+          const VoxelStats* sw = reader_.stats(w);
+          if (sw->count && std::abs(surface_height(w, sw) - h_v) <= opt_.neighbourhood_dz_m) {
+            const double n = sw->count;
+            const Eigen::Vector3d m(sw->mean[0] + dx * vs, sw->mean[1] + dy * vs,
+                                    sw->mean[2] + dz * vs);
+            sum_m += n * m;
+            Eigen::Matrix3d m2;
+            m2 << sw->m2[0], sw->m2[1], sw->m2[2], sw->m2[1], sw->m2[3], sw->m2[4], sw->m2[2],
+                sw->m2[4], sw->m2[5];
+            sum_s += m2 + n * m * m.transpose();
+            n_agg += n;
+          }
+        }
+        above_occ = occ;
+      }
+    }
+  const Eigen::Vector3d mean = sum_m / n_agg;
+  const Eigen::Matrix3d cov = sum_s / n_agg - mean * mean.transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
+  es.computeDirect(cov);
+  const Eigen::Vector3d ev = es.eigenvalues().cwiseMax(0.0);  // ascending l1 <= l2 <= l3
+  // Collinear points (a single scan line on the floor) leave the normal undetermined: not yet
+  // observable, like N(v) < N_min.
+  if (!(ev[2] > 0) || ev[1] < 1e-3 * ev[2]) {
+    s->reasons = VoxelStats::kReasonDegenerate;
+    return TravState::kUnobserved;
+  }
+  const Eigen::Vector3d nrm = es.eigenvectors().col(0);
+  const double slope = std::acos(std::min(1.0, std::abs(nrm.z())));             // s(v), Eq. 1
+  const double rough = 1.0 - (ev[1] - ev[0]) / std::max(1e-18, ev[1] + ev[0]);  // r(v), Eq. 1
+  const double under = 1.0 - std::min(1.0, n_agg / double(opt_.n_ref));         // u(v)
+  // Eq. 2 with s_bar = s / max_slope, r_bar = r, u_bar = u (all 1 at their limits).
+  const double cost = opt_.w_s * slope / robot_.max_slope_rad + opt_.w_r * rough + opt_.w_u * under;
+  s->cost = float(cost);
+  s->normal_z = float(std::abs(nrm.z()));
+  if (cost > opt_.tau_c) s->reasons |= VoxelStats::kReasonCost;
+
+  // R_col(v): an occupied voxel whose points lie above the step height and below the body
+  // clearance, within collision_radius_m of v's column.
+  const double clear = robot_.body_height_m + robot_.body_margin_m;
+  const int rc2 = r_col_ * r_col_;
+  for (int dx = -r_col_; dx <= r_col_ && !(s->reasons & VoxelStats::kReasonCollision); ++dx)
+    for (int dy = -r_col_; dy <= r_col_; ++dy) {
+      if (dx * dx + dy * dy > rc2) continue;
+      bool hit = false;
+      for (int dz = 0; dz <= h_clear_ + 1 && !hit; ++dz) {
+        const VoxelKey w{k.x + dx, k.y + dy, k.z + dz};
+        const Cell* cw = rcell(w);
+        if (!occupied(cw)) continue;
+        const double dh =
+            surface_height(w, cw->stats == Cell::kNoStats ? nullptr : reader_.stats(w)) - h_v;
+        hit = dh > robot_.step_height_m && dh <= clear;
+      }
+      if (hit) {
+        s->reasons |= VoxelStats::kReasonCollision;
+        break;
+      }
+    }
+
+  // R_fall(v): a neighbour column is safe if it holds an occupied voxel from one step below
+  // v's surface up to the body clearance (ground to stand on, or a wall, not a drop). Too few
+  // safe columns within the neighbourhood radius means v is at a ledge.
+  int total = 0, safe = 0;
+  for (int dx = -r_agg_; dx <= r_agg_; ++dx)
+    for (int dy = -r_agg_; dy <= r_agg_; ++dy) {
+      if ((dx == 0 && dy == 0) || dx * dx + dy * dy > r2) continue;
+      ++total;
+      for (int dz = -dz_step_ - 1; dz <= h_clear_ + 1; ++dz) {
+        const VoxelKey w{k.x + dx, k.y + dy, k.z + dz};
+        const Cell* cw = rcell(w);
+        if (!occupied(cw)) continue;
+        const double dh =
+            surface_height(w, cw->stats == Cell::kNoStats ? nullptr : reader_.stats(w)) - h_v;
+        if (dh >= -robot_.step_height_m && dh <= clear) {
+          ++safe;
+          break;
+        }
+      }
+    }
+  if (total > 0 && double(safe) < opt_.fall_support_ratio * double(total))
+    s->reasons |= VoxelStats::kReasonFall;
+
+  return s->reasons ? TravState::kUntraversable : TravState::kTraversable;  // Eq. 3
+}
+
+}  // namespace storey::core::map

@@ -1,0 +1,192 @@
+#include "core/map/traversability_map.hpp"
+
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+#include "core/map/voxel_ray.hpp"
+
+namespace storey::core::map {
+
+namespace {
+int16_t quantise(float log_odds) {
+  const float q = std::round(log_odds * kLogOddsScale);
+  return int16_t(std::clamp(q, -32000.0f, 32000.0f));
+}
+int voxels_ceil(double metres, double voxel) {
+  return int(std::ceil(metres / voxel - 1e-9));
+}
+void require(bool ok, const char* what) {
+  if (!ok) throw std::invalid_argument(std::string("MapOptions: ") + what);
+}
+}  // namespace
+
+TraversabilityMap::TraversabilityMap(const MapOptions& o, const RobotModel& r)
+    : opt_(o), robot_(r) {
+  require(std::isfinite(o.voxel_size_m) && o.voxel_size_m >= 0.01 && o.voxel_size_m <= 2.0,
+          "voxel_size_m must be in [0.01, 2] m");
+  require(o.max_range_m > o.min_range_m && o.min_range_m >= 0,
+          "need 0 <= min_range_m < max_range_m");
+  require(o.log_odds_hit > 0 && o.log_odds_miss < 0, "log_odds_hit > 0 and log_odds_miss < 0");
+  require(o.log_odds_min < o.log_odds_occupied && o.log_odds_occupied < o.log_odds_max,
+          "need log_odds_min < log_odds_occupied < log_odds_max");
+  require(o.log_odds_min > -30 && o.log_odds_max < 30, "log-odds clamps must be within +-30");
+  require(o.n_min >= 1 && o.n_ref >= 1, "n_min and n_ref must be >= 1");
+  require(o.neighbourhood_radius_m >= 0 && o.collision_radius_m >= 0, "radii must be >= 0");
+  require(r.max_slope_rad > 0 && r.step_height_m >= 0 && r.body_height_m > 0,
+          "RobotModel: max_slope_rad > 0, step_height_m >= 0, body_height_m > 0");
+  hit_q_ = quantise(o.log_odds_hit);
+  miss_q_ = quantise(o.log_odds_miss);
+  min_q_ = quantise(o.log_odds_min);
+  max_q_ = quantise(o.log_odds_max);
+  occ_q_ = quantise(o.log_odds_occupied);
+  const double s = o.voxel_size_m;
+  r_agg_ = voxels_ceil(o.neighbourhood_radius_m, s);
+  r_col_ = voxels_ceil(o.collision_radius_m, s);
+  dz_step_ = voxels_ceil(r.step_height_m, s);
+  h_clear_ = voxels_ceil(r.body_height_m + r.body_margin_m, s);
+  dz_agg_ = voxels_ceil(o.neighbourhood_dz_m, s) + 1;
+}
+
+VoxelBlock* TraversabilityMap::wblock(const VoxelKey& k, bool create) {
+  const uint64_t bk = block_key_of(k);
+  if (wblock_ && bk == wkey_) return wblock_;
+  VoxelBlock* b =
+      store_.find_mutable(bk, k.x >> kBlockBits, k.y >> kBlockBits, k.z >> kBlockBits, create);
+  if (!b) return nullptr;
+  if (b->scan_id != scan_id_) {  // first write in this scan: the de-dup bits are stale
+    std::memset(b->touched, 0, sizeof(b->touched));
+    b->scan_id = scan_id_;
+  }
+  wkey_ = bk;
+  wblock_ = b;
+  return b;
+}
+
+void TraversabilityMap::mark_changed(const VoxelKey& k, Cell& c) {
+  if (c.flags & Cell::kChanged) return;
+  c.flags |= Cell::kChanged;
+  changed_.push_back(k);
+}
+
+InsertStats TraversabilityMap::insert_scan(const Eigen::Vector3f& o,
+                                           std::span<const Eigen::Vector3f> pts) {
+  InsertStats st;
+  st.points = uint32_t(pts.size());
+  const float lim = float(opt_.world_limit_m);
+  auto in_world = [lim](const Eigen::Vector3f& p) {
+    return std::isfinite(p.x()) && std::isfinite(p.y()) && std::isfinite(p.z()) &&
+           std::abs(p.x()) <= lim && std::abs(p.y()) <= lim && std::abs(p.z()) <= lim;
+  };
+  if (!in_world(o)) {
+    st.origin_invalid = true;
+    st.dropped_invalid = st.points;
+    return st;
+  }
+  // New scan: fresh de-dup bits. The cached write block's bits belong to the previous scan, so
+  // the cache is dropped here (wblock() resets a block's bits on its first fetch in a scan).
+  if (++scan_id_ == 0) scan_id_ = 1;
+  wblock_ = nullptr;
+  ++version_;
+
+  const double s = opt_.voxel_size_m, inv = 1.0 / s;
+  const float min2 = float(opt_.min_range_m * opt_.min_range_m);
+  const float max2 = float(opt_.max_range_m * opt_.max_range_m);
+  constexpr uint32_t kTruncated = 0x80000000u;
+  ray_points_.clear();
+
+  // Pass 1: endpoints (hits first so that a voxel both hit and crossed this scan counts as hit).
+  for (uint32_t i = 0; i < pts.size(); ++i) {
+    const Eigen::Vector3f& p = pts[i];
+    if (!in_world(p)) {
+      ++st.dropped_invalid;
+      continue;
+    }
+    const float r2 = (p - o).squaredNorm();
+    if (r2 < min2) {
+      ++st.dropped_min_range;
+      continue;
+    }
+    if (r2 > max2) {
+      ++st.truncated;
+      ray_points_.push_back(i | kTruncated);
+      continue;
+    }
+    ++st.hits;
+    const VoxelKey k = floor_key(p.x() * inv, p.y() * inv, p.z() * inv);
+    VoxelBlock* b = wblock(k, true);
+    const int idx = cell_index(k);
+    Cell& c = b->cells[idx];
+    if (!b->test_and_set_touched(idx)) {  // first hit of this voxel in this scan
+      const bool was_occ = occupied(&c);
+      c.flags |= Cell::kObserved;
+      c.log_odds = int16_t(std::min<int>(c.log_odds + hit_q_, max_q_));
+      if (!was_occ && occupied(&c)) {
+        ++occupied_count_;
+        mark_changed(k, c);
+      }
+      ray_points_.push_back(i);
+    }
+    if (c.stats == Cell::kNoStats) c.stats = b->alloc_stats();
+    VoxelStats& vs = b->stats[c.stats];
+    vs.add(float(p.x() - (k.x + 0.5) * s), float(p.y() - (k.y + 0.5) * s),
+           float(p.z() - (k.z + 0.5) * s));
+    // Re-evaluate tau(v) when N(v) reaches N_min or doubles since the last evaluation: the
+    // statistics of a well-observed voxel barely move, so re-running Eq. 1-3 on every point
+    // would cost without changing the state.
+    if (vs.count == uint32_t(opt_.n_min) || vs.count >= 2 * vs.count_eval) mark_changed(k, c);
+  }
+
+  // Pass 2: free space along each de-duplicated ray.
+  auto miss = [&](const VoxelKey& k) {
+    VoxelBlock* b = wblock(k, true);
+    const int idx = cell_index(k);
+    if (b->test_and_set_touched(idx)) return true;  // already hit or missed in this scan
+    Cell& c = b->cells[idx];
+    const bool was_occ = occupied(&c);
+    c.flags |= Cell::kObserved;
+    c.log_odds = int16_t(std::max<int>(c.log_odds + miss_q_, min_q_));
+    if (was_occ && !occupied(&c)) {
+      --occupied_count_;
+      mark_changed(k, c);
+    }
+    return true;
+  };
+  const double ox = o.x() * inv, oy = o.y() * inv, oz = o.z() * inv;
+  for (uint32_t e : ray_points_) {
+    const bool truncated = e & kTruncated;
+    const Eigen::Vector3f& p = pts[e & ~kTruncated];
+    double ex = p.x() * inv, ey = p.y() * inv, ez = p.z() * inv;
+    if (truncated) {  // clear up to max range, no endpoint
+      const double f = opt_.max_range_m / double((p - o).norm());
+      ex = ox + (ex - ox) * f;
+      ey = oy + (ey - oy) * f;
+      ez = oz + (ez - oz) * f;
+    }
+    st.voxels_walked += walk_ray(ox, oy, oz, ex, ey, ez, miss);
+    if (truncated) miss(floor_key(ex, ey, ez));
+    ++st.rays_cast;
+  }
+  st.changed = uint32_t(changed_.size());
+  return st;
+}
+
+std::shared_ptr<const MapSnapshot> TraversabilityMap::snapshot() {
+  // Every block is now shared with the snapshot: the cached write pointer must not be used
+  // for writing again (the next wblock() clones the block first).
+  wblock_ = nullptr;
+  reader_.invalidate();
+  return std::make_shared<const MapSnapshot>(store_, opt_, robot_, version_, occupied_count_,
+                                             trav_count_, reach_count_);
+}
+
+size_t TraversabilityMap::mem_usage() const {
+  return sizeof(*this) + store_.mem_usage() + ray_points_.capacity() * sizeof(uint32_t) +
+         (changed_.capacity() + dirty_.capacity() + orphans_.capacity() + grow_queue_.capacity()) *
+             sizeof(VoxelKey) +
+         reach_changed_.capacity() * sizeof(ReachChange) +
+         orphan_queue_.capacity() * sizeof(orphan_queue_[0]);
+}
+
+}  // namespace storey::core::map

@@ -1,0 +1,231 @@
+#include "core/map/traversability_map.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "core/map/ply_export.hpp"
+#include "core/map/voxel_ray.hpp"
+#include "tests/core_map/synthetic_world.hpp"
+
+using namespace storey::core::map;
+using Eigen::Vector3f;
+
+namespace {
+MapOptions opts() {
+  MapOptions o;
+  o.voxel_size_m = 0.1;
+  o.min_range_m = 0.3;
+  o.max_range_m = 10.0;
+  return o;
+}
+int16_t q(float lo) {
+  return int16_t(std::lround(lo * kLogOddsScale));
+}
+const Cell* cell_at(const TraversabilityMap& m, const VoxelKey& k) {
+  BlockReader r(m.view().store());
+  return r.cell(k);
+}
+}  // namespace
+
+TEST(TraversabilityMap, RejectsBadOptions) {
+  MapOptions o = opts();
+  o.voxel_size_m = 0;
+  EXPECT_THROW(TraversabilityMap{o}, std::invalid_argument);
+  o = opts();
+  o.max_range_m = 0.1;
+  EXPECT_THROW(TraversabilityMap{o}, std::invalid_argument);
+}
+
+TEST(TraversabilityMap, SingleRayFreeVoxelsAreExactlyTheDdaVoxels) {
+  TraversabilityMap m(opts());
+  const Vector3f o(0.05f, 0.05f, 0.05f), p(2.34f, 1.21f, 0.47f);
+  const std::vector<Vector3f> pts = {p};
+  const InsertStats st = m.insert_scan(o, pts);
+  EXPECT_EQ(st.hits, 1u);
+  EXPECT_EQ(st.rays_cast, 1u);
+  std::vector<VoxelKey> expect_free;
+  walk_ray(0.5, 0.5, 0.5, 23.4, 12.1, 4.7, [&](const VoxelKey& k) {
+    expect_free.push_back(k);
+    return true;
+  });
+  const MapView v = m.view();
+  for (const VoxelKey& k : expect_free) {
+    EXPECT_EQ(v.occupancy(k), Occupancy::kFree);
+    EXPECT_EQ(cell_at(m, k)->log_odds, q(opts().log_odds_miss));
+  }
+  const VoxelKey end = v.key_of(p);
+  EXPECT_EQ(v.occupancy(end), Occupancy::kOccupied);
+  EXPECT_EQ(cell_at(m, end)->log_odds, q(opts().log_odds_hit));
+  EXPECT_EQ(v.point_count(end), 1u);
+  // Count observed voxels: exactly DDA voxels + endpoint.
+  size_t observed = 0;
+  m.view().store().for_each([&](const VoxelBlock& b) {
+    for (const Cell& c : b.cells) observed += (c.flags & Cell::kObserved) ? 1 : 0;
+  });
+  EXPECT_EQ(observed, expect_free.size() + 1);
+  EXPECT_EQ(v.occupancy(Vector3f(-1, -1, -1)), Occupancy::kUnknown);
+  EXPECT_EQ(m.occupied_voxels(), 1u);
+}
+
+TEST(TraversabilityMap, DeduplicatesPerScanAndHitWins) {
+  TraversabilityMap m(opts());
+  const Vector3f o(0.05f, 0.05f, 0.05f);
+  // Three points in one voxel; a fourth ray passes through that voxel to a farther point.
+  std::vector<Vector3f> pts = {
+      {1.01f, 0.05f, 0.05f}, {1.05f, 0.06f, 0.04f}, {1.09f, 0.02f, 0.08f}, {3.05f, 0.05f, 0.05f}};
+  const InsertStats st = m.insert_scan(o, pts);
+  EXPECT_EQ(st.hits, 4u);
+  EXPECT_EQ(st.rays_cast, 2u);  // de-duplicated by endpoint voxel
+  const MapView v = m.view();
+  const VoxelKey k = v.key_of(pts[0]);
+  EXPECT_EQ(cell_at(m, k)->log_odds, q(opts().log_odds_hit));  // once, despite 3 hits + 1 miss
+  EXPECT_EQ(v.point_count(k), 3u);                             // but every point counted
+  // A voxel crossed by both rays is missed once.
+  EXPECT_EQ(cell_at(m, v.key_of(Vector3f(0.55f, 0.05f, 0.05f)))->log_odds, q(opts().log_odds_miss));
+}
+
+TEST(TraversabilityMap, LogOddsClampAtBothEnds) {
+  TraversabilityMap m(opts());
+  const Vector3f o(0.05f, 0.05f, 0.05f);
+  const std::vector<Vector3f> near = {{1.05f, 0.05f, 0.05f}}, far = {{3.05f, 0.05f, 0.05f}};
+  for (int i = 0; i < 50; ++i) m.insert_scan(o, near);
+  const VoxelKey k = m.view().key_of(near[0]);
+  EXPECT_EQ(cell_at(m, k)->log_odds, q(opts().log_odds_max));
+  for (int i = 0; i < 50; ++i) m.insert_scan(o, far);
+  EXPECT_EQ(cell_at(m, k)->log_odds, q(opts().log_odds_min));
+  EXPECT_EQ(m.view().occupancy(k), Occupancy::kFree);
+  EXPECT_EQ(m.occupied_voxels(), 1u);  // only the far endpoint
+}
+
+TEST(TraversabilityMap, MaxRangeTruncatesAndMinRangeDrops) {
+  MapOptions o = opts();
+  o.max_range_m = 2.0;
+  TraversabilityMap m(o);
+  const Vector3f origin(0.05f, 0.05f, 0.05f);
+  const std::vector<Vector3f> pts = {
+      {5.05f, 0.05f, 0.05f}, {0.15f, 0.05f, 0.05f}, {NAN, 0, 0}, {1e9f, 0, 0}};
+  const InsertStats st = m.insert_scan(origin, pts);
+  EXPECT_EQ(st.truncated, 1u);
+  EXPECT_EQ(st.dropped_min_range, 1u);
+  EXPECT_EQ(st.dropped_invalid, 2u);
+  EXPECT_EQ(st.hits, 0u);
+  const MapView v = m.view();
+  EXPECT_EQ(v.occupancy(Vector3f(1.95f, 0.05f, 0.05f)), Occupancy::kFree);
+  EXPECT_EQ(v.occupancy(Vector3f(2.05f, 0.05f, 0.05f)), Occupancy::kFree);  // the max-range voxel
+  EXPECT_EQ(v.occupancy(Vector3f(2.25f, 0.05f, 0.05f)), Occupancy::kUnknown);
+  EXPECT_EQ(v.occupancy(Vector3f(5.05f, 0.05f, 0.05f)), Occupancy::kUnknown);
+  EXPECT_EQ(m.occupied_voxels(), 0u);
+  const InsertStats bad = m.insert_scan(Vector3f(NAN, 0, 0), pts);
+  EXPECT_TRUE(bad.origin_invalid);
+  EXPECT_EQ(bad.dropped_invalid, 4u);
+}
+
+TEST(TraversabilityMap, WelfordStatisticsMatchBatch) {
+  TraversabilityMap m(opts());
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(0.2001f, 0.2999f);
+  std::vector<Vector3f> all;
+  for (int scan = 0; scan < 20; ++scan) {
+    std::vector<Vector3f> pts;
+    for (int i = 0; i < 50; ++i) pts.emplace_back(u(rng) + 3.0f, u(rng), u(rng) * 0.3f + 0.2f);
+    all.insert(all.end(), pts.begin(), pts.end());
+    m.insert_scan(Vector3f(0.05f, 0.05f, 0.25f), pts);
+  }
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const Vector3f& p : all) mean += p.cast<double>();
+  mean /= double(all.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const Vector3f& p : all)
+    cov += (p.cast<double>() - mean) * (p.cast<double>() - mean).transpose();
+  const MapView v = m.view();
+  const VoxelKey k = v.key_of(all[0]);
+  BlockReader r(v.store());
+  const VoxelStats* s = r.stats(k);
+  ASSERT_NE(s, nullptr);
+  ASSERT_EQ(s->count, all.size());
+  const Eigen::Vector3d c = v.centre_of(k).cast<double>();
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(s->mean[i] + c[i], mean[i], 1e-5);
+  const double m2[6] = {cov(0, 0), cov(0, 1), cov(0, 2), cov(1, 1), cov(1, 2), cov(2, 2)};
+  for (int i = 0; i < 6; ++i) EXPECT_NEAR(s->m2[i], m2[i], 1e-5 * std::max(1.0, std::abs(m2[i])));
+}
+
+TEST(TraversabilityMap, SnapshotIsImmutableWhileOwnerWrites) {
+  TraversabilityMap m(opts());
+  const Vector3f o(0.05f, 0.05f, 0.05f);
+  const std::vector<Vector3f> a = {{1.05f, 0.05f, 0.05f}}, b = {{3.05f, 0.05f, 0.05f}};
+  m.insert_scan(o, a);
+  auto snap = m.snapshot();
+  const VoxelKey k = m.view().key_of(a[0]);
+  for (int i = 0; i < 10; ++i) m.insert_scan(o, b);  // clears k in the live map
+  EXPECT_EQ(m.view().occupancy(k), Occupancy::kFree);
+  EXPECT_EQ(snap->view().occupancy(k), Occupancy::kOccupied);
+  EXPECT_EQ(snap->view().occupancy(Vector3f(3.05f, 0.05f, 0.05f)), Occupancy::kUnknown);
+  EXPECT_EQ(snap->occupied_voxels(), 1u);
+  EXPECT_GT(m.view().store().cow_copies(), 0u);
+  auto snap2 = m.snapshot();
+  EXPECT_GT(snap2->version(), snap->version());
+  EXPECT_EQ(snap2->view().occupancy(k), Occupancy::kFree);
+}
+
+TEST(TraversabilityMap, RayAndBoxQueries) {
+  storey::test::World w;
+  w.add(storey::test::aabb({-5, -5, -0.2f}, {5, 5, 0.03f}));
+  w.add(storey::test::aabb({2.0f, -1, 0}, {2.2f, 1, 2}));  // wall
+  TraversabilityMap m(opts());
+  for (int i = 0; i < 4; ++i) {
+    const Vector3f o(0, 0, 0.5f);
+    m.insert_scan(o, storey::test::scan_dense(w, o, 40000, 10 + i));
+  }
+  const MapView v = m.view();
+  const auto hit = v.first_occupied(Vector3f(0, 0, 0.5f), Vector3f(4, 0, 0.5f));
+  ASSERT_TRUE(hit.has_value());
+  EXPECT_NEAR(v.centre_of(*hit).x(), 2.05f, 0.11f);
+  EXPECT_FALSE(v.is_segment_free(Vector3f(0, 0, 0.5f), Vector3f(4, 0, 0.5f), true));
+  EXPECT_TRUE(v.is_segment_free(Vector3f(0, 0, 0.35f), Vector3f(0, 1.5f, 0.35f), false));
+  EXPECT_EQ(v.probe(Vector3f(0, 0, 0.5f), Vector3f(0, 0, 9.0f)), Occupancy::kUnknown);  // above
+  std::vector<Vector3f> occ;
+  EXPECT_GT(v.occupied_in_box(Vector3f(2.1f, 0, 1), Vector3f(0.3f, 0.3f, 0.3f), occ), 10u);
+  for (const Vector3f& c : occ) EXPECT_NEAR(c.x(), 2.1f, 0.41f);
+  const auto surf = v.support_surface_near(Vector3f(1.0f, 0.5f, 0.1f), 0.3);
+  ASSERT_TRUE(surf.has_value());
+  EXPECT_NEAR(surf->height_m, 0.03f, 0.02f);
+  EXPECT_TRUE(v.is_free_above(surf->key, 0.4, false));
+  EXPECT_FALSE(v.is_free_above(v.key_of(Vector3f(1.95f, 0.0f, 0.02f)), 0.4, true) &&
+               v.is_occupied(v.key_of(Vector3f(2.05f, 0.0f, 0.05f))) &&
+               !v.is_free_above(v.key_of(Vector3f(2.05f, 0.0f, 0.05f)), 0.4, true));
+}
+
+TEST(TraversabilityMap, PlyExportWritesEveryOccupiedVoxel) {
+  storey::test::World w;
+  w.add(storey::test::aabb({-3, -3, -0.2f}, {3, 3, 0.03f}));
+  TraversabilityMap m(opts());
+  const Vector3f o(0, 0, 0.5f);
+  for (int i = 0; i < 3; ++i) m.insert_scan(o, storey::test::scan_dense(w, o, 30000, i));
+  m.update_traversability();
+  m.update_reachable(Vector3f(0, 0, 0.03f));
+  const std::string path = std::string(STOREY_BINARY_DIR) + "/core_map_test.ply";
+  const PlyExportResult r = write_ply_occupied(m.view(), path);
+  ASSERT_TRUE(r.ok) << r.error;
+  EXPECT_EQ(r.vertices, m.occupied_voxels());
+  std::ifstream f(path, std::ios::binary);
+  std::string line;
+  std::getline(f, line);
+  EXPECT_EQ(line, "ply");
+  std::getline(f, line);
+  EXPECT_EQ(line, "format binary_little_endian 1.0");
+  const PlyExportResult rr = write_ply_reachable(m.view(), path + ".reach.ply");
+  ASSERT_TRUE(rr.ok);
+  EXPECT_EQ(rr.vertices, m.reachable_voxels());
+  EXPECT_GT(rr.vertices, 100u);
+  const PlyExportResult bad = write_ply_occupied(m.view(), "/nonexistent-dir/x.ply");
+  EXPECT_FALSE(bad.ok);
+  EXPECT_NE(bad.error.find("/nonexistent-dir/x.ply"), std::string::npos);
+  std::remove(path.c_str());
+  std::remove((path + ".reach.ply").c_str());
+}
