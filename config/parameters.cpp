@@ -1,5 +1,6 @@
 #include "config/parameters.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -238,11 +239,15 @@ class CrossChecker {
     for (const ConfigError& e : ctx.errors()) bad_.insert(e.key);
   }
 
-  // Requires `ok`; otherwise reports `msg` on key `a` (or on `b` when only `b` was given in a
-  // file, so the line points at what the user wrote). Skipped if either key already failed.
+  // Requires `ok`; otherwise reports `msg` on key `a`, or on `b` when `b` was set in a later
+  // layer (so the line points at what the user changed last). Skipped if either key already
+  // failed its own check.
   void require(bool ok, const std::string& a, const std::string& b, const std::string& msg) {
     if (ok || bad_.count(a) != 0 || bad_.count(b) != 0) return;
-    const std::string& key = (!ctx_.was_set(a) && ctx_.was_set(b)) ? b : a;
+    const Location none{top_, 0};
+    const bool b_later = ctx_.set_order(b) > ctx_.set_order(a) &&
+                         ctx_.origin(b, none).file != ctx_.origin(a, none).file;
+    const std::string& key = (b_later || (!ctx_.was_set(a) && ctx_.was_set(b))) ? b : a;
     ctx_.error(ctx_.origin(key, Location{top_, 0}), key, msg);
   }
 
@@ -342,10 +347,18 @@ class Loader {
       cross_check(params_, ctx_, top);
     }
     Result r;
+    r.errors = ctx_.take_errors();
+    // Errors in reading order of the files (base first), then by line.
+    auto rank = [this](const ConfigError& e) {
+      std::size_t i = 0;
+      while (i < files_.size() && files_[i] != e.where.file) ++i;
+      return std::make_pair(i, e.where.line);
+    };
+    std::stable_sort(r.errors.begin(), r.errors.end(),
+                     [&](const ConfigError& x, const ConfigError& y) { return rank(x) < rank(y); });
     r.params = params_;
     r.origins = ctx_.origins();
     r.schema_keys.assign(ctx_.asked().begin(), ctx_.asked().end());
-    r.errors = ctx_.take_errors();
     r.files = std::move(files_);
     return r;
   }

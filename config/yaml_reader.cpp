@@ -74,6 +74,12 @@ void ReadContext::error(Location where, std::string key, std::string message) {
 
 void ReadContext::set_origin(const std::string& key, Location where) {
   origins_[key] = std::move(where);
+  set_order_[key] = next_order_++;
+}
+
+long ReadContext::set_order(const std::string& key) const {
+  auto it = set_order_.find(key);
+  return it == set_order_.end() ? -1 : it->second;
 }
 
 Location ReadContext::origin(const std::string& key, const Location& fallback) const {

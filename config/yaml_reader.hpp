@@ -73,6 +73,9 @@ class ReadContext {
   Location origin(const std::string& key, const Location& fallback) const;
   bool was_set(const std::string& key) const { return origins_.count(key) != 0; }
   const std::map<std::string, Location>& origins() const { return origins_; }
+  // Order in which `key` was last set (layers are read base first, so a higher number is a
+  // later layer); -1 if never set.
+  long set_order(const std::string& key) const;
 
   // Every value key any reader asked for: the schema, as far as it was walked.
   void note_asked(const std::string& key) { asked_.insert(key); }
@@ -86,6 +89,8 @@ class ReadContext {
  private:
   std::vector<ConfigError> errors_;
   std::map<std::string, Location> origins_;
+  std::map<std::string, long> set_order_;
+  long next_order_ = 0;
   std::map<std::string, Location> required_;  // key -> last place it was asked for
   std::set<std::string> asked_;
 };
