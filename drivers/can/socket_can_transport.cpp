@@ -160,12 +160,13 @@ CanIoStatus SocketCanTransport::receive(CanFrame& f) {
     // if that never comes, re-create the socket periodically so that a re-plugged interface or
     // a manual `ip link set canX up` is picked up.
     const int64_t now = now_ns();
-    if (fd_ < 0 || now - bus_off_since_ns_ > options_.reopen_period_ns) {
+    if (now - bus_off_since_ns_ > options_.reopen_period_ns) {
       close_socket();
       bus_off_since_ns_ = now;
       if (!open_socket()) return CanIoStatus::error;
       ++stats_.reopens;
     }
+    if (fd_ < 0) return CanIoStatus::error;
   }
   canfd_frame fr{};
   ssize_t r = 0;
