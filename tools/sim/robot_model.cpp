@@ -121,12 +121,29 @@ void RobotModel::physics_step(const VelocityCommand& cmd_in) {
     nz = centre.hit ? centre.z : s_.position.z() - kFallDepth;
   }
   double pitch = s_.pitch, roll = s_.roll;
+  double fx = nx, fy = ny;
   if (!blocked) {
     attitude(nx, ny, nyaw, nz, &pitch, &roll);
     RobotState trial = s_;
     trial.position = {nx, ny, nz};
     trial.yaw = nyaw, trial.pitch = pitch, trial.roll = roll;
-    blocked = body_collides(trial.body_pose());
+    if (fell) {
+      // The body tips over the edge: it lands clear of the ledge, pushed on along its motion
+      // (or away from its heading when standing) until the box no longer meets the world.
+      const double mx = nx - s_.position.x(), my = ny - s_.position.y();
+      const double ml = std::hypot(mx, my);
+      const double ux = ml > 1e-9 ? mx / ml : std::cos(nyaw),
+                   uy = ml > 1e-9 ? my / ml : std::sin(nyaw);
+      for (int k = 0; k <= 20 && body_collides(trial.body_pose()); ++k) {
+        fx = nx + ux * 0.05 * k, fy = ny + uy * 0.05 * k;
+        const Probe p = probe(fx, fy, nz + opt_.step_height);
+        trial.position = {fx, fy, p.hit ? p.z : nz};
+      }
+      nz = trial.position.z();
+      attitude(fx, fy, nyaw, nz, &pitch, &roll);
+    } else {
+      blocked = body_collides(trial.body_pose());
+    }
   }
   if (blocked) {
     if (!s_.blocked) ++s_.collisions;
@@ -134,7 +151,7 @@ void RobotModel::physics_step(const VelocityCommand& cmd_in) {
     s_.velocity.setZero();
   } else {
     if (fell) ++s_.falls;
-    const Eigen::Vector3d np(nx, ny, nz);
+    const Eigen::Vector3d np(fx, fy, nz);
     s_.distance += (np - s_.position).norm();
     s_.position = np;
     s_.yaw = std::remainder(nyaw, 2.0 * M_PI);
