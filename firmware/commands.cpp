@@ -6,6 +6,8 @@ std::span<const Command> commands() {
   static const Command kCommands[] = {
       {"check-config", "validate a configuration file (errors name file, key and line)",
        cmd_check_config},
+      {"replay", "recorded LiDAR packets (pcap, pcapng, .lvx2) through ingestion and scan assembly",
+       cmd_replay},
       {"self-check", "quick check of this build: clocks, scheduler, queues, default config",
        cmd_self_check},
   };

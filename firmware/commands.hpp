@@ -17,5 +17,6 @@ std::span<const Command> commands();
 
 int cmd_self_check(int argc, char** argv);
 int cmd_check_config(int argc, char** argv);
+int cmd_replay(int argc, char** argv);
 
 }  // namespace storey::firmware
