@@ -462,8 +462,19 @@ void build_ramp(Builder& b, const Reader& r, const YAML::Node& n, std::vector<Fl
     z = zb;
     if (i + 1 < sv.size()) {
       const auto& nx = sv[i + 1];
-      const Rect land = {std::min(s[2], nx[0]) - w / 2, std::min(s[3], nx[1]) - w / 2,
-                         std::max(s[2], nx[0]) + w / 2, std::max(s[3], nx[1]) + w / 2};
+      // The landing starts where this segment ends and reaches w beyond it, and covers the
+      // next segment's start the same way, so no sloped part lies under it.
+      const double nl = std::hypot(nx[2] - nx[0], nx[3] - nx[1]);
+      const double vx = (nx[2] - nx[0]) / nl, vy = (nx[3] - nx[1]) / nl;
+      const double ptsx[4] = {s[2], s[2] + ux * w, nx[0], nx[0] - vx * w};
+      const double ptsy[4] = {s[3], s[3] + uy * w, nx[1], nx[1] - vy * w};
+      Rect land = {1e18, 1e18, -1e18, -1e18};
+      for (int q = 0; q < 4; ++q) {
+        const bool along_x = q < 2 ? std::abs(ux) > 0.5 : std::abs(vx) > 0.5;
+        const double lx = along_x ? 0.0 : w / 2, ly = along_x ? w / 2 : 0.0;
+        land = {std::min(land[0], ptsx[q] - lx), std::min(land[1], ptsy[q] - ly),
+                std::max(land[2], ptsx[q] + lx), std::max(land[3], ptsy[q] + ly)};
+      }
       rect_box(b, land, z0, z);
       up.openings.push_back(land);
       if (walls) {
@@ -474,9 +485,9 @@ void build_ramp(Builder& b, const Reader& r, const YAML::Node& n, std::vector<Fl
           const bool horizontal = std::abs(y1 - y0) < 1e-9;
           const double dist = horizontal ? std::abs(ey - y0) : std::abs(ex - x0);
           const bool vertical_seg = std::abs(sg[0] - sg[2]) < 1e-9;
-          if (std::abs(dist - w / 2) > 1e-6 || horizontal != vertical_seg) return;
+          if (dist > wt + 1e-6 || horizontal != vertical_seg) return;
           const double c = horizontal ? ex - x0 : ey - y0;
-          gaps.push_back({c - w / 2, w, true});
+          gaps.push_back({c - w / 2 - wt, w + 2 * wt, true});
         };
         const double L0 = land[0] - wt, L1 = land[1] - wt, L2 = land[2] + wt, L3 = land[3] + wt;
         const std::array<std::array<double, 4>, 4> sides = {
@@ -485,7 +496,6 @@ void build_ramp(Builder& b, const Reader& r, const YAML::Node& n, std::vector<Fl
           std::vector<Door> gaps;
           gap_on(s, true, sd[0], sd[1], sd[2], sd[3], gaps);
           gap_on(nx, false, sd[0], sd[1], sd[2], sd[3], gaps);
-          for (auto& g : gaps) g.at += wt;  // the side line starts wt before the landing
           wall(b, sd[0], sd[1], sd[2], sd[3], wt * 2, z0, top, gaps, top - z0 + 1.0);
         }
       }
