@@ -166,6 +166,23 @@ TEST(UdpFrame, RoundTripAndHeaderFields) {
   EXPECT_EQ(std::memcmp(payload, p, len), 0);
 }
 
+TEST(UdpFrame, ReadmeExampleBytes) {
+  // drivers/go2/README.md "Wire format" example, byte for byte.
+  const uint8_t expected[] = {0x53, 0x47, 0x01, 0x02, 0x00, 0x00, 0x14, 0x00, 0x07, 0x00, 0x00,
+                              0x00, 0xd0, 0x07, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0xe8, 0x03,
+                              0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x3f, 0x00,
+                              0x00, 0x00, 0x00, 0xcd, 0xcc, 0xcc, 0x3d, 0x9b, 0xa3, 0xa0, 0x20};
+  uint8_t p[kVelocityPayloadSize];
+  encode_velocity(VelocityCommand{1000, 0.5f, 0.0f, 0.1f}, p);
+  FrameHeader h;
+  h.type = static_cast<uint8_t>(MsgType::velocity_command);
+  h.sequence = 7;
+  h.timestamp_ns = 2000;
+  uint8_t f[kUdpMaxFrameSize];
+  ASSERT_EQ(encode_udp_frame(h, p, sizeof(p), f), sizeof(expected));
+  EXPECT_EQ(std::memcmp(f, expected, sizeof(expected)), 0);
+}
+
 TEST(UdpFrame, EveryBitFlipIsDetected) {
   RobotState s = sample_state();
   uint8_t p[kStatePayloadSize];
