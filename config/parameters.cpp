@@ -113,6 +113,18 @@ void read_graph(SectionReader&& r, core::graph::GraphOptions& o) {
   r.get("use_c_sur", o.use_c_sur);
   r.get("use_c_exp", o.use_c_exp);
   r.get("boundary_frontiers", o.boundary_frontiers);
+  r.get("neighbour_radius_factor", o.neighbour_radius_factor, Range{1.0, 5.0});
+  r.get_deg("max_edge_slope_deg", o.max_edge_slope_rad, Range{0.0, 75.0});
+  r.get("max_gap_m", o.max_gap_m, Range{0.0, 5.0});
+  r.get("surface_tolerance_m", o.surface_tolerance_m, Range{0.0, 0.5});
+  r.get("root_radius_m", o.root_radius_m, Range{0.05, 10.0});
+  r.get("floor_height_hint_m", o.floor_height_hint_m, Range{1.0, 20.0});
+  r.get("max_expansions_per_update", o.max_expansions_per_update, Range{1, 1000000});
+  r.get("max_revalidations_per_update", o.max_revalidations_per_update, Range{1, 10000000});
+  r.get("surface_samples", o.surface_samples, Range{1, 4096});
+  r.get("probe_height_m", o.probe_height_m, Range{0.0, 3.0});
+  r.get("boundary_radius_m", o.boundary_radius_m, Range{0.01, 10.0});
+  r.get("viewpoint_target_height_m", o.viewpoint_target_height_m, Range{0.0, 3.0});
 }
 
 void read_plan(SectionReader&& r, core::plan::PlanOptions& o) {

@@ -102,14 +102,24 @@ void ReadContext::check_required() {
 SectionReader::SectionReader(YAML::Node node, std::string path,
                              std::shared_ptr<const std::string> file, int key_line,
                              ReadContext& ctx)
-    : node_(std::move(node)),
-      path_(std::move(path)),
-      file_(std::move(file)),
-      key_line_(key_line),
-      ctx_(&ctx) {}
+    : path_(std::move(path)), file_(std::move(file)), key_line_(key_line), ctx_(&ctx) {
+  if (!node.IsMap()) return;
+  entries_.reserve(node.size());
+  for (const auto& kv : node) {
+    entries_.push_back(Entry{kv.first.IsScalar() ? kv.first.Scalar() : std::string(), kv.first,
+                             kv.second, line_of(kv.first, key_line_)});
+  }
+}
+
+const SectionReader::Entry* SectionReader::find(std::string_view key) const {
+  for (const Entry& e : entries_) {
+    if (e.key == key && e.key_node.IsScalar()) return &e;
+  }
+  return nullptr;
+}
 
 SectionReader::SectionReader(SectionReader&& other) noexcept
-    : node_(std::move(other.node_)),
+    : entries_(std::move(other.entries_)),
       path_(std::move(other.path_)),
       file_(std::move(other.file_)),
       key_line_(other.key_line_),
@@ -134,16 +144,12 @@ void SectionReader::known(std::string_view key) {
 std::optional<std::pair<YAML::Node, int>> SectionReader::lookup(std::string_view key, Need need) {
   known_.emplace(key);
   ctx_->note_asked(path_of(key));
-  if (node_.IsMap()) {
-    for (const auto& kv : node_) {
-      if (!kv.first.IsScalar() || kv.first.Scalar() != key) continue;
-      const int line = line_of(kv.first, key_line_);
-      if (kv.second.IsNull()) {
-        ctx_->error(here(line), path_of(key), "missing value");
-        return std::nullopt;
-      }
-      return std::make_pair(kv.second, line);
+  if (const Entry* e = find(key)) {
+    if (e->value.IsNull()) {
+      ctx_->error(here(e->line), path_of(key), "missing value");
+      return std::nullopt;
     }
+    return std::make_pair(e->value, e->line);
   }
   if (need == Need::kRequired) ctx_->note_required(path_of(key), here(key_line_));
   return std::nullopt;
@@ -353,17 +359,13 @@ std::optional<std::size_t> SectionReader::get_choice(std::string_view key,
 SectionReader SectionReader::section(std::string_view key, Need need) {
   known_.emplace(key);
   const std::string path = path_of(key);
-  if (node_.IsMap()) {
-    for (const auto& kv : node_) {
-      if (!kv.first.IsScalar() || kv.first.Scalar() != key) continue;
-      const int line = line_of(kv.first, key_line_);
-      if (kv.second.IsMap()) return SectionReader(kv.second, path, file_, line, *ctx_);
-      // An empty section (`map:` with nothing under it) is allowed: it sets nothing.
-      if (!kv.second.IsNull()) {
-        ctx_->error(here(line), path, "expected a mapping, got " + describe(kv.second));
-      }
-      return SectionReader(YAML::Node(), path, file_, line, *ctx_);
+  if (const Entry* e = find(key)) {
+    if (e->value.IsMap()) return SectionReader(e->value, path, file_, e->line, *ctx_);
+    // An empty section (`map:` with nothing under it) is allowed: it sets nothing.
+    if (!e->value.IsNull()) {
+      ctx_->error(here(e->line), path, "expected a mapping, got " + describe(e->value));
     }
+    return SectionReader(YAML::Node(), path, file_, e->line, *ctx_);
   }
   if (need == Need::kRequired) ctx_->note_required(path, here(key_line_));
   return SectionReader(YAML::Node(), path, file_, key_line_, *ctx_);
@@ -372,26 +374,23 @@ SectionReader SectionReader::section(std::string_view key, Need need) {
 void SectionReader::finish() {
   if (finished_) return;
   finished_ = true;
-  if (!node_.IsMap()) return;
   std::map<std::string, int, std::less<>> seen;  // key -> first line
-  for (const auto& kv : node_) {
-    const int line = line_of(kv.first, key_line_);
-    if (!kv.first.IsScalar()) {
-      ctx_->error(here(line), path_, "keys must be plain names, got " + describe(kv.first));
+  for (const Entry& e : entries_) {
+    if (!e.key_node.IsScalar()) {
+      ctx_->error(here(e.line), path_, "keys must be plain names, got " + describe(e.key_node));
       continue;
     }
-    const std::string& key = kv.first.Scalar();
-    if (auto [it, fresh] = seen.emplace(key, line); !fresh) {
-      ctx_->error(here(line), path_of(key),
+    if (auto [it, fresh] = seen.emplace(e.key, e.line); !fresh) {
+      ctx_->error(here(e.line), path_of(e.key),
                   "duplicate key (first given on line " + std::to_string(it->second) + ")");
       continue;
     }
-    if (known_.count(key) != 0) continue;
+    if (known_.count(e.key) != 0) continue;
     std::string msg = "unknown key";
-    if (std::string near = closest_match(key, known_); !near.empty()) {
+    if (std::string near = closest_match(e.key, known_); !near.empty()) {
       msg += " (did you mean '" + near + "'?)";
     }
-    ctx_->error(here(line), path_of(key), msg);
+    ctx_->error(here(e.line), path_of(e.key), msg);
   }
 }
 

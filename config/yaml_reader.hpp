@@ -173,7 +173,17 @@ class SectionReader {
   std::optional<std::size_t> get_choice(std::string_view key,
                                         std::span<const std::string_view> names, Need need);
 
-  YAML::Node node_;
+  // The mapping's entries, indexed once (yaml-cpp iteration is slow; sections are read key by
+  // key). A non-scalar key (a list or mapping used as a key) has an empty name.
+  struct Entry {
+    std::string key;
+    YAML::Node key_node;
+    YAML::Node value;
+    int line;
+  };
+  const Entry* find(std::string_view key) const;
+
+  std::vector<Entry> entries_;
   std::string path_;
   std::shared_ptr<const std::string> file_;
   int key_line_ = 0;

@@ -434,10 +434,45 @@ namespace {
 TEST(ConfigSchema, CoreOptionStructsAreFullyMapped) {
   EXPECT_EQ(sizeof(core::RobotModel), 80u) << "RobotModel changed: update the config schema";
   EXPECT_EQ(sizeof(core::map::MapOptions), 136u) << "MapOptions changed: update the config schema";
-  EXPECT_EQ(sizeof(core::graph::GraphOptions), 96u)
+  EXPECT_EQ(sizeof(core::graph::GraphOptions), 184u)
       << "GraphOptions changed: update the config schema";
   EXPECT_EQ(sizeof(core::plan::PlanOptions), 80u)
       << "PlanOptions changed: update the config schema";
+}
+
+}  // namespace
+}  // namespace storey::config
+
+namespace storey::config {
+namespace {
+
+// Bad input never crashes the loader: damaged copies of default.yaml (a byte removed, replaced
+// or duplicated at spread positions) each load to either a valid result or named errors.
+TEST(ConfigRobustness, DamagedDefaultNeverCrashesAndAlwaysExplains) {
+  std::ifstream in(kConfigDir + "default.yaml");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_GT(text.size(), 1000u);
+  const char kBytes[] = {':',  '-', '[', '{', '"', '\'', '\t', ' ',
+                         '\n', '#', '&', '*', '!', 'x',  '9',  '\0'};
+  int variants = 0, failed = 0;
+  for (std::size_t pos = 0; pos < text.size(); pos += 61) {
+    for (int kind = 0; kind < 3; ++kind) {
+      std::string t = text;
+      if (kind == 0) t.erase(pos, 1);
+      if (kind == 1) t[pos] = kBytes[(pos / 61) % sizeof kBytes];
+      if (kind == 2) t.insert(pos, 1, t[pos]);
+      const Result r = load_string(t, "damaged.yaml");
+      ++variants;
+      if (r.ok()) continue;
+      ++failed;
+      for (const ConfigError& e : r.errors) {
+        ASSERT_EQ(e.where.file, "damaged.yaml") << e.to_string();
+        ASSERT_FALSE(e.message.empty());
+      }
+    }
+  }
+  EXPECT_GT(variants, 400);          // ~9 KB / 61 * 3
+  EXPECT_GT(failed, variants / 10);  // the damage is noticed, not silently accepted
 }
 
 }  // namespace
