@@ -24,8 +24,8 @@ struct MapOptions {
   double w_u = 0.3;                     // w_u, Eq. 2 under-observation weight (u_bar = u)
   double tau_c = 1.0;                // tau_c, Eq. 3 maximum terrain cost; 1.0 so that slope alone
                                      // reaches it exactly at RobotModel::max_slope_rad
-  double fall_support_ratio = 0.75;  // R_fall: fewer supported neighbour columns than this
-                                     // fraction within neighbourhood_radius_m -> fall risk
+  double fall_support_ratio = 0.75;  // R_fall: more than (1 - this) of the neighbour columns
+                                     // within neighbourhood_radius_m are observed drops -> fall
   double collision_radius_m = 0.1;   // R_col: horizontal radius of the clearance column above v
   // --- reachable set ---
   double seed_search_radius_m = 1.0;  // robot support voxel: nearest traversable within this

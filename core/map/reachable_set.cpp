@@ -7,8 +7,9 @@
 // smaller count. Growth adds voxels with parent count + 1. Removal (a member turned
 // untraversable or lost its edge) orphans it and, transitively, every neighbour with a larger
 // count that finds no other neighbour with a smaller one; then the orphans are regrown from
-// the surviving boundary. A full regrow from the seed happens only when the root itself is lost
-// or the robot stands on a different component.
+// the surviving boundary. Several roots (count 0) form a BFS forest: when the robot's seed is
+// outside the set it becomes a new root. Losing a root orphans it like any member; a full
+// regrow from the seed happens only when no root is left (or the root list is full).
 #include <algorithm>
 #include <limits>
 #include <unordered_set>
@@ -117,8 +118,7 @@ void TraversabilityMap::regrow_from(const VoxelKey& seed, ReachUpdateStats& st) 
   for (const VoxelKey& k : orphans_) clear_reachable(k);
   st.orphaned += uint32_t(orphans_.size());
   orphans_.clear();
-  has_root_ = true;
-  root_ = seed;
+  roots_.assign(1, seed);
   set_reachable(seed, 0);
   ++st.grown;
   grow_queue_.clear();
@@ -130,20 +130,36 @@ ReachUpdateStats TraversabilityMap::update_reachable(const Eigen::Vector3f& foot
   ReachUpdateStats st;
   const std::optional<VoxelKey> seed = find_seed(foot);
   st.has_seed = seed.has_value();
-  const Cell* root_cell = has_root_ ? rcell(root_) : nullptr;
-  if (!root_cell || root_cell->state != TravState::kTraversable) {
-    // No tree yet, or its root was lost: rebuild from the robot (or empty the set).
+  orphan_queue_.clear();
+  orphans_.clear();
+  // Roots that are no longer traversable leave the forest; they are orphaned below.
+  for (size_t i = 0; i < roots_.size();) {
+    const Cell* c = rcell(roots_[i]);
+    if (c && c->state == TravState::kTraversable) {
+      ++i;
+      continue;
+    }
+    if (c && (c->flags & Cell::kReachable)) {
+      clear_reachable(roots_[i]);
+      orphans_.push_back(roots_[i]);
+      ++st.orphaned;
+    }
+    orphan_queue_.push_back({roots_[i], 0});
+    roots_.erase(roots_.begin() + long(i));
+  }
+  if (roots_.empty()) {
+    // No forest left: rebuild from the robot (or empty the set).
     if (seed) {
       regrow_from(*seed, st);
-    } else if (has_root_) {
+    } else {
       orphans_.clear();
       MapView(store_, opt_, robot_)
           .for_each_occupied([&](const VoxelKey& k, const Cell& c, const VoxelStats*) {
             if (c.flags & Cell::kReachable) orphans_.push_back(k);
           });
       for (const VoxelKey& k : orphans_) clear_reachable(k);
-      st.orphaned = uint32_t(orphans_.size());
-      has_root_ = false;
+      st.orphaned += uint32_t(orphans_.size());
+      orphans_.clear();
     }
     reach_changed_.clear();
     return st;
@@ -152,8 +168,6 @@ ReachUpdateStats TraversabilityMap::update_reachable(const Eigen::Vector3f& foot
   // Decremental pass. Sources: members that changed. A member that is no longer traversable
   // or lost every parent edge is orphaned; every source (orphaned or not, since its height may
   // have changed) has its larger-count neighbours re-checked.
-  orphan_queue_.clear();
-  orphans_.clear();
   for (const ReachChange& rc : reach_changed_) {
     if (!rc.was_reachable) continue;
     const Cell* c = rcell(rc.key);
@@ -161,7 +175,7 @@ ReachUpdateStats TraversabilityMap::update_reachable(const Eigen::Vector3f& foot
       orphan_queue_.push_back({rc.key, rc.old_dist});
       continue;
     }
-    if (rc.key == root_) {
+    if (is_root(rc.key)) {
       orphan_queue_.push_back({rc.key, 0});
       continue;
     }
@@ -179,7 +193,7 @@ ReachUpdateStats TraversabilityMap::update_reachable(const Eigen::Vector3f& foot
       for (int dz = -dz_step_; dz <= dz_step_; ++dz) {
         const VoxelKey w{u.x + kDx[i], u.y + kDy[i], u.z + dz};
         const Cell* cw = rcell(w);
-        if (!cw || !(cw->flags & Cell::kReachable) || w == root_) continue;
+        if (!cw || !(cw->flags & Cell::kReachable) || is_root(w)) continue;
         const uint32_t dw = rstats(w)->reach_dist;
         if (dw <= du || has_parent(w, dw)) continue;
         clear_reachable(w);
@@ -213,12 +227,24 @@ ReachUpdateStats TraversabilityMap::update_reachable(const Eigen::Vector3f& foot
   reach_changed_.clear();
   orphans_.clear();
 
-  // The robot walked onto a component C_reach does not contain: rebuild from there.
-  if (seed && !(rcell(*seed)->flags & Cell::kReachable)) regrow_from(*seed, st);
+  // The robot stands on ground C_reach does not contain: that ground is reachable too.
+  if (seed && !(rcell(*seed)->flags & Cell::kReachable)) {
+    if (roots_.size() >= kMaxRoots) {
+      regrow_from(*seed, st);  // bounded forest: start over from the robot
+    } else {
+      st.new_root = true;
+      roots_.push_back(*seed);
+      set_reachable(*seed, 0);
+      ++st.grown;
+      grow_queue_.push_back(*seed);
+      grow_bfs(st);
+    }
+  }
   return st;
 }
 
-std::vector<VoxelKey> TraversabilityMap::grow_from_scratch(const VoxelKey& seed) const {
+std::vector<VoxelKey> TraversabilityMap::grow_from_scratch(
+    const std::vector<VoxelKey>& seeds) const {
   BlockReader r(store_);
   auto trav = [&](const VoxelKey& k) {
     const Cell* c = r.cell(k);
@@ -231,9 +257,9 @@ std::vector<VoxelKey> TraversabilityMap::grow_from_scratch(const VoxelKey& seed)
     }
   };
   std::vector<VoxelKey> out;
-  if (!trav(seed)) return out;
-  std::unordered_set<VoxelKey, Hash> seen{seed};
-  out.push_back(seed);
+  std::unordered_set<VoxelKey, Hash> seen;
+  for (const VoxelKey& s : seeds)
+    if (trav(s) && seen.insert(s).second) out.push_back(s);
   for (size_t q = 0; q < out.size(); ++q) {
     const VoxelKey u = out[q];
     const float hu = height(u);

@@ -157,27 +157,32 @@ TravState TraversabilityMap::evaluate(const VoxelKey& k, VoxelStats* s) {
       }
     }
 
-  // R_fall(v): a neighbour column is safe if it holds an occupied voxel from one step below
-  // v's surface up to the body clearance (ground to stand on, or a wall, not a drop). Too few
-  // safe columns within the neighbourhood radius means v is at a ledge.
-  int total = 0, safe = 0;
+  // R_fall(v): a neighbour column is a drop if nothing occupied lies from one step below v's
+  // surface up to the body clearance (no ground to stand on, and no wall) while the space just
+  // below v's level is observed free (v's own level is not evidence: rays graze through the
+  // upper part of floor voxels). Unknown columns are no evidence either way (under-observed
+  // ground is S_unobs territory, not a ledge). Too many drops in the neighbourhood: a ledge.
+  int total = 0, drops = 0;
   for (int dx = -r_agg_; dx <= r_agg_; ++dx)
     for (int dy = -r_agg_; dy <= r_agg_; ++dy) {
       if ((dx == 0 && dy == 0) || dx * dx + dy * dy > r2) continue;
       ++total;
-      for (int dz = -dz_step_ - 1; dz <= h_clear_ + 1; ++dz) {
+      bool safe = false, seen_free = false;
+      for (int dz = -dz_step_ - 1; dz <= h_clear_ + 1 && !safe; ++dz) {
         const VoxelKey w{k.x + dx, k.y + dy, k.z + dz};
         const Cell* cw = rcell(w);
-        if (!occupied(cw)) continue;
+        if (!cw || !(cw->flags & Cell::kObserved)) continue;
+        if (!occupied(cw)) {
+          seen_free |= dz >= -dz_step_ && dz < 0;
+          continue;
+        }
         const double dh =
             surface_height(w, cw->stats == Cell::kNoStats ? nullptr : reader_.stats(w)) - h_v;
-        if (dh >= -robot_.step_height_m && dh <= clear) {
-          ++safe;
-          break;
-        }
+        safe = dh >= -robot_.step_height_m && dh <= clear;
       }
+      drops += !safe && seen_free;
     }
-  if (total > 0 && double(safe) < opt_.fall_support_ratio * double(total))
+  if (total > 0 && double(drops) > (1.0 - opt_.fall_support_ratio) * double(total))
     s->reasons |= VoxelStats::kReasonFall;
 
   return s->reasons ? TravState::kUntraversable : TravState::kTraversable;  // Eq. 3

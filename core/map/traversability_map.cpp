@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <string>
 
+#include <Eigen/LU>
+
 #include "core/map/voxel_ray.hpp"
 
 namespace storey::core::map {
@@ -138,6 +140,24 @@ InsertStats TraversabilityMap::insert_scan(const Eigen::Vector3f& o,
     if (vs.count == uint32_t(opt_.n_min) || vs.count >= 2 * vs.count_eval) mark_changed(k, c);
   }
 
+  const double ox = o.x() * inv, oy = o.y() * inv, oz = o.z() * inv;
+  // A ray crossing an occupied voxel only counts as a miss if it passes through the voxel's
+  // point distribution (Mahalanobis distance <= 3 from the points' Gaussian, as in NDT-OM,
+  // Saarinen et al. 2013). Otherwise grazing rays over a floor would erode the floor voxels,
+  // whose points fill only the bottom of the voxel.
+  Eigen::Vector3d ray_dir;  // unit, world frame, set per ray below
+  auto ray_meets_points = [&](const VoxelKey& k, const VoxelStats& vs) {
+    if (vs.count < 3) return true;
+    const Eigen::Vector3d mean((k.x + 0.5) * s + vs.mean[0], (k.y + 0.5) * s + vs.mean[1],
+                               (k.z + 0.5) * s + vs.mean[2]);
+    const Eigen::Vector3d rel = mean - o.cast<double>();
+    const Eigen::Vector3d delta = rel - ray_dir * rel.dot(ray_dir);  // mean -> nearest ray point
+    const double n = vs.count, reg = 0.0025 * s * s;  // (5% of a voxel)^2 regulariser
+    Eigen::Matrix3d cov;
+    cov << vs.m2[0] / n + reg, vs.m2[1] / n, vs.m2[2] / n, vs.m2[1] / n, vs.m2[3] / n + reg,
+        vs.m2[4] / n, vs.m2[2] / n, vs.m2[4] / n, vs.m2[5] / n + reg;
+    return delta.dot(cov.inverse() * delta) <= 9.0;  // closed-form 3x3 inverse
+  };
   // Pass 2: free space along each de-duplicated ray.
   auto miss = [&](const VoxelKey& k) {
     VoxelBlock* b = wblock(k, true);
@@ -145,6 +165,8 @@ InsertStats TraversabilityMap::insert_scan(const Eigen::Vector3f& o,
     if (b->test_and_set_touched(idx)) return true;  // already hit or missed in this scan
     Cell& c = b->cells[idx];
     const bool was_occ = occupied(&c);
+    if (was_occ && c.stats != Cell::kNoStats && !ray_meets_points(k, b->stats[c.stats]))
+      return true;  // grazes past the surface in this voxel: no evidence against it
     c.flags |= Cell::kObserved;
     c.log_odds = int16_t(std::max<int>(c.log_odds + miss_q_, min_q_));
     if (was_occ && !occupied(&c)) {
@@ -153,7 +175,6 @@ InsertStats TraversabilityMap::insert_scan(const Eigen::Vector3f& o,
     }
     return true;
   };
-  const double ox = o.x() * inv, oy = o.y() * inv, oz = o.z() * inv;
   for (uint32_t e : ray_points_) {
     const bool truncated = e & kTruncated;
     const Eigen::Vector3f& p = pts[e & ~kTruncated];
@@ -164,6 +185,7 @@ InsertStats TraversabilityMap::insert_scan(const Eigen::Vector3f& o,
       ey = oy + (ey - oy) * f;
       ez = oz + (ez - oz) * f;
     }
+    ray_dir = Eigen::Vector3d(ex - ox, ey - oy, ez - oz).normalized();
     st.voxels_walked += walk_ray(ox, oy, oz, ex, ey, ez, miss);
     if (truncated) miss(floor_key(ex, ey, ez));
     ++st.rays_cast;

@@ -4,6 +4,7 @@
 // Owned by one thread (the firmware's map task). Per scan: insert_scan() (ray casting, voxel
 // statistics), update_traversability() (Eq. 1-3 on the dirty set), update_reachable() (C_reach),
 // then snapshot() publishes an immutable copy-on-write view for other threads.
+#include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -45,7 +46,8 @@ struct TravUpdateStats {
 
 struct ReachUpdateStats {
   bool has_seed = false;     // a traversable support voxel was found under the robot
-  bool full_regrow = false;  // the set was regrown from the seed (root lost or moved away)
+  bool full_regrow = false;  // the set was regrown from the seed (every root lost)
+  bool new_root = false;     // the seed was outside C_reach and became a root
   uint32_t orphaned = 0;     // voxels removed by the decremental pass
   uint32_t grown = 0;        // voxels added
 };
@@ -70,7 +72,11 @@ class TraversabilityMap {
   TravUpdateStats update_traversability();
 
   // Maintains C_reach: seed = nearest traversable support voxel under the robot's feet
-  // (robot_foot_m: a point on the ground between the feet [m]).
+  // (robot_foot_m: a point on the ground between the feet [m]). The set is the union of the
+  // components of the roots: the first seed, plus every later seed that was not already in the
+  // set (the robot crossed ground too under-observed to connect yet; where it walked stays
+  // reachable). A root that turns untraversable is dropped; with no root left, the set is
+  // regrown from the current seed.
   ReachUpdateStats update_reachable(const Eigen::Vector3f& robot_foot_m);
 
   // Immutable, shareable view of the current map (copy-on-write of blocks).
@@ -79,11 +85,9 @@ class TraversabilityMap {
   // Queries on the live map (owner thread only, valid until the next mutating call).
   MapView view() const { return MapView(store_, opt_, robot_); }
 
-  // C_reach recomputed from scratch from `seed` (testing / validation): keys in BFS order.
-  std::vector<VoxelKey> grow_from_scratch(const VoxelKey& seed) const;
-  std::optional<VoxelKey> reach_root() const {
-    return has_root_ ? std::optional<VoxelKey>(root_) : std::nullopt;
-  }
+  // C_reach recomputed from scratch from `seeds` (testing / validation): keys in BFS order.
+  std::vector<VoxelKey> grow_from_scratch(const std::vector<VoxelKey>& seeds) const;
+  const std::vector<VoxelKey>& reach_roots() const { return roots_; }
 
   uint64_t occupied_voxels() const { return occupied_count_; }
   uint64_t traversable_voxels() const { return trav_count_; }
@@ -163,8 +167,11 @@ class TraversabilityMap {
   std::vector<VoxelKey> orphans_;
   std::vector<VoxelKey> grow_queue_;
 
-  bool has_root_ = false;
-  VoxelKey root_;
+  bool is_root(const VoxelKey& k) const {
+    return std::find(roots_.begin(), roots_.end(), k) != roots_.end();
+  }
+  static constexpr size_t kMaxRoots = 64;
+  std::vector<VoxelKey> roots_;  // dist 0 members of the BFS forest
   uint64_t occupied_count_ = 0, trav_count_ = 0, reach_count_ = 0;
 };
 

@@ -1,0 +1,203 @@
+// Eq. 1-3 and C_reach on analytic surfaces (paper Sec. III-A): what a legged robot can and
+// cannot stand on, observed by a synthetic LiDAR from several poses.
+#include <cmath>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "core/map/traversability_map.hpp"
+#include "tests/core_map/synthetic_world.hpp"
+
+using namespace storey::core::map;
+using Eigen::Vector3f;
+using storey::test::aabb;
+using storey::test::World;
+
+namespace {
+constexpr float kDeg = float(M_PI) / 180.f;
+
+void survey(TraversabilityMap& m, const World& w, const std::vector<Vector3f>& origins,
+            const Vector3f& foot, int scans = 2, int rays = 60000) {
+  uint32_t seed = 1;
+  for (const Vector3f& o : origins)
+    for (int i = 0; i < scans; ++i) {
+      m.insert_scan(o, storey::test::scan_dense(w, o, rays, seed++));
+      m.update_traversability();
+      m.update_reachable(foot);
+    }
+}
+
+struct Tally {
+  int samples = 0, found = 0, trav = 0, reach = 0, fall = 0, col = 0;
+  std::string str() const {
+    return "samples " + std::to_string(samples) + " found " + std::to_string(found) + " trav " +
+           std::to_string(trav) + " reach " + std::to_string(reach) + " fall " +
+           std::to_string(fall) + " col " + std::to_string(col);
+  }
+};
+
+// Samples the surface z = height(x, y) on a grid over [x0,x1] x [y0,y1] and tallies the
+// state of the support voxel found there.
+Tally tally(const TraversabilityMap& m, float x0, float x1, float y0, float y1,
+            const std::function<float(float, float)>& height, float step = 0.1f) {
+  Tally t;
+  const MapView v = m.view();
+  BlockReader r(v.store());
+  for (float x = x0 + 0.05f; x < x1; x += step)
+    for (float y = y0 + 0.05f; y < y1; y += step) {
+      ++t.samples;
+      const auto s = v.support_surface_near(Vector3f(x, y, height(x, y)), 0.12);
+      if (!s) continue;
+      ++t.found;
+      t.trav += s->state == TravState::kTraversable;
+      t.reach += s->reachable;
+      const VoxelStats* st = r.stats(s->key);
+      if (st) {
+        t.fall += (st->reasons & VoxelStats::kReasonFall) != 0;
+        t.col += (st->reasons & VoxelStats::kReasonCollision) != 0;
+      }
+    }
+  return t;
+}
+
+World floor_world(float half = 6.f) {
+  World w;
+  w.add(aabb({-half, -half, -0.3f}, {half, half, 0.03f}));
+  return w;
+}
+std::vector<Vector3f> ring_of_origins(float z, float r = 1.5f) {
+  return {{0, 0, z}, {r, 0, z}, {-r, 0, z}, {0, r, z}, {0, -r, z}};
+}
+}  // namespace
+
+TEST(Terrain, FlatFloorIsTraversableAndReachable) {
+  TraversabilityMap m;
+  survey(m, floor_world(), ring_of_origins(0.55f), Vector3f(0, 0, 0.03f));
+  const Tally t = tally(m, -3, 3, -3, 3, [](float, float) { return 0.03f; });
+  // The scanner does not see straight down (elevation >= -69 deg): a 0.2 m blind disc under
+  // each of the 5 origins, as under a real robot.
+  EXPECT_GE(t.found, t.samples * 97 / 100) << t.str();
+  EXPECT_GE(t.trav, t.samples * 95 / 100) << t.str();
+  EXPECT_GE(t.reach, t.samples * 95 / 100) << t.str();
+  EXPECT_NEAR(m.reachable_volume_m3(), double(m.reachable_voxels()) * 1e-3, 1e-9);
+  EXPECT_GT(m.traversable_volume_m3(), 36 * 0.1 * 0.9);  // >= 90% of a 6x6 m floor, 1 voxel deep
+}
+
+TEST(Terrain, Ramp20DegIsTraversableAndReachable) {
+  World w = floor_world(8.f);
+  const float a = 20 * kDeg;
+  w.add(storey::test::ramp(1.0f, -1.0f, 1.0f, 0.03f, 3.0f, a));
+  w.add(aabb({4.0f, -1.0f, -0.3f}, {6.0f, 1.0f, 0.03f + 3.0f * std::tan(a)}));  // landing
+  TraversabilityMap m;
+  survey(m, w,
+         {{0, 0, 0.55f}, {2.0f, 0, 0.95f}, {3.0f, 0, 1.3f}, {5.0f, 0, 1.7f}, {0, 1.5f, 0.55f}},
+         Vector3f(0, 0, 0.03f));
+  const Tally t = tally(m, 1.4f, 3.6f, -0.6f, 0.6f,
+                        [a](float x, float) { return 0.03f + (x - 1.0f) * std::tan(a); });
+  EXPECT_GE(t.trav, t.samples * 90 / 100) << t.str();
+  EXPECT_GE(t.reach, t.samples * 90 / 100) << t.str();
+  const Tally land =
+      tally(m, 4.3f, 5.7f, -0.6f, 0.6f, [a](float, float) { return 0.03f + 3.0f * std::tan(a); });
+  EXPECT_GE(land.reach, land.samples * 90 / 100) << land.str();
+}
+
+TEST(Terrain, Stairs17cmAreTraversableAndReachable) {
+  World w = floor_world(8.f);
+  const float rise = 0.17f, tread = 0.30f;
+  const int n = 6;
+  w.stairs(1.0f, -0.7f, 0.7f, 0.03f, n, rise, tread);
+  w.add(aabb({1.0f + n * tread, -0.7f, -0.3f}, {1.0f + n * tread + 2.0f, 0.7f, 0.03f + n * rise}));
+  TraversabilityMap m;
+  std::vector<Vector3f> origins = {{0, 0, 0.55f}, {0, 1.0f, 0.55f}};
+  for (int i = 0; i <= n; i += 2)
+    origins.emplace_back(1.0f + (i + 0.5f) * tread, 0, 0.6f + (i + 1) * rise);
+  origins.emplace_back(1.0f + n * tread + 1.0f, 0, 0.55f + n * rise);
+  survey(m, w, origins, Vector3f(0, 0, 0.03f));
+  for (int i = 0; i < n; ++i) {
+    // The middle of each tread, away from its nosing and riser.
+    const float xs = 1.0f + i * tread + 0.1f, xe = 1.0f + (i + 1) * tread - 0.1f;
+    const float h = 0.03f + (i + 1) * rise;
+    const Tally t = tally(m, xs - 0.05f, xe, -0.4f, 0.4f, [h](float, float) { return h; });
+    EXPECT_GE(t.trav, t.samples * 80 / 100) << "tread " << i << ": " << t.str();
+    EXPECT_GE(t.reach, t.samples * 80 / 100) << "tread " << i << ": " << t.str();
+  }
+  const float top = 0.03f + n * rise;
+  const Tally land = tally(m, 1.0f + n * tread + 0.3f, 1.0f + n * tread + 1.7f, -0.4f, 0.4f,
+                           [top](float, float) { return top; });
+  EXPECT_GE(land.reach, land.samples * 90 / 100) << land.str();
+}
+
+TEST(Terrain, Slope45DegIsNotTraversable) {
+  World w = floor_world(8.f);
+  const float a = 45 * kDeg;
+  w.add(storey::test::ramp(1.0f, -1.5f, 1.5f, 0.03f, 2.0f, a));
+  TraversabilityMap m;
+  survey(m, w, {{0, 0, 0.55f}, {0, 1.5f, 0.55f}, {0, -1.5f, 0.55f}, {-1.0f, 0, 1.5f}},
+         Vector3f(0, 0, 0.03f));
+  const Tally t = tally(m, 1.3f, 2.7f, -1.0f, 1.0f,
+                        [a](float x, float) { return 0.03f + (x - 1.0f) * std::tan(a); });
+  EXPECT_GE(t.found, t.samples * 70 / 100) << t.str();
+  EXPECT_EQ(t.trav, 0) << t.str();
+  EXPECT_EQ(t.reach, 0) << t.str();
+}
+
+TEST(Terrain, LedgeEdgeHasFallRisk) {
+  // A 1 m high platform; the robot stands on it. Its edge voxels have no support below.
+  World w = floor_world(8.f);
+  w.add(aabb({-2, -2, -0.3f}, {2.02f, 2, 1.03f}));
+  TraversabilityMap m;
+  survey(m, w,
+         {{0, 0, 1.55f},
+          {1.0f, 0, 1.55f},
+          {1.0f, 1.0f, 1.55f},
+          {1.0f, -1.0f, 1.55f},
+          {1.9f, 0.5f, 1.55f},
+          {1.9f, -0.5f, 1.55f}},
+         Vector3f(0, 0, 1.03f));
+  // The outermost voxel column, [2.0, 2.1) in x, holding the last 2 cm of the platform: half
+  // of its neighbourhood is a 1 m drop.
+  const Tally edge = tally(m, 1.96f, 2.05f, -1.0f, 1.0f, [](float, float) { return 1.03f; });
+  EXPECT_GE(edge.found, edge.samples * 90 / 100) << edge.str();
+  EXPECT_EQ(edge.trav, 0) << edge.str();
+  EXPECT_GE(edge.fall, edge.found * 90 / 100) << edge.str();
+  const Tally inner = tally(m, 0.5f, 1.6f, -1.0f, 1.0f, [](float, float) { return 1.03f; });
+  EXPECT_GE(inner.trav, inner.samples * 90 / 100) << inner.str();
+  EXPECT_GE(inner.reach, inner.samples * 90 / 100) << inner.str();
+  // The floor below the ledge is traversable but not reachable (1 m drop).
+  const Tally below = tally(m, 3.0f, 4.0f, -1.0f, 1.0f, [](float, float) { return 0.03f; });
+  EXPECT_GE(below.trav, below.samples * 80 / 100) << below.str();
+  EXPECT_EQ(below.reach, 0) << below.str();
+}
+
+TEST(Terrain, LowCeilingCollides) {
+  // A 0.1 m slab whose underside is 0.33 m above the floor (below the 0.45 m body clearance).
+  World w = floor_world(8.f);
+  w.add(aabb({1.5f, -1.5f, 0.36f}, {4.5f, 1.5f, 0.46f}));
+  TraversabilityMap m;
+  survey(m, w,
+         {{0, 0, 0.2f}, {2.0f, 0, 0.2f}, {3.0f, 0.5f, 0.2f}, {4.0f, -0.5f, 0.2f}, {-1, 0, 0.6f}},
+         Vector3f(0, 0, 0.03f));
+  const Tally under = tally(m, 2.0f, 4.0f, -1.0f, 1.0f, [](float, float) { return 0.03f; });
+  EXPECT_GE(under.found, under.samples * 90 / 100) << under.str();
+  EXPECT_EQ(under.trav, 0) << under.str();
+  EXPECT_GE(under.col, under.found * 95 / 100) << under.str();
+  const Tally open = tally(m, -1.0f, 1.0f, -1.0f, 1.0f, [](float, float) { return 0.03f; });
+  EXPECT_GE(open.trav, open.samples * 90 / 100) << open.str();
+}
+
+TEST(Terrain, TableTopIsTraversableButNotReachable) {
+  World w = floor_world(8.f);
+  w.add(aabb({1.0f, -0.75f, 0.72f}, {2.5f, 0.75f, 0.78f}));  // top 1.5 x 1.5 m at 0.78 m
+  for (float x : {1.05f, 2.4f})
+    for (float y : {-0.7f, 0.65f}) w.add(aabb({x, y, 0.0f}, {x + 0.05f, y + 0.05f, 0.72f}));
+  TraversabilityMap m;
+  survey(m, w, {{0, 0, 1.5f}, {0, 1.0f, 1.5f}, {3.5f, 0, 1.5f}, {1.75f, 2.0f, 1.5f}},
+         Vector3f(0, 0, 0.03f));
+  const Tally top = tally(m, 1.3f, 2.2f, -0.45f, 0.45f, [](float, float) { return 0.78f; });
+  EXPECT_GE(top.trav, top.samples * 90 / 100) << top.str();
+  EXPECT_EQ(top.reach, 0) << top.str();
+  const Tally floor = tally(m, -1.0f, 0.5f, -1.0f, 1.0f, [](float, float) { return 0.03f; });
+  EXPECT_GE(floor.reach, floor.samples * 90 / 100) << floor.str();
+}
