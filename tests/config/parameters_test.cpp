@@ -477,3 +477,35 @@ TEST(ConfigRobustness, DamagedDefaultNeverCrashesAndAlwaysExplains) {
 
 }  // namespace
 }  // namespace storey::config
+
+namespace storey::config {
+namespace {
+
+TEST(ConfigErrors, DdsDiscoveryAndPeerList) {
+  const Result none = load_string(
+      "sensor:\n  type: mid360\nlink:\n  transport: dds\n  dds:\n    allow_multicast: false\n",
+      "t.yaml");
+  ASSERT_EQ(messages(none).size(), 1u) << joined(none);
+  EXPECT_EQ(messages(none)[0],
+            "t.yaml:6: link.dds.allow_multicast: link.dds.peers is empty and "
+            "link.dds.allow_multicast is false: no discovery");
+
+  const Result bad = load_string(
+      "sensor:\n  type: mid360\nlink:\n  transport: dds\n  dds:\n    allow_multicast: false\n"
+      "    peers: [127.0.0.1, robot]\n",
+      "t.yaml");
+  ASSERT_EQ(messages(bad).size(), 1u) << joined(bad);
+  EXPECT_EQ(messages(bad)[0],
+            "t.yaml:7: link.dds.peers[1]: 'robot' is not an IPv4 address (a.b.c.d)");
+
+  const Result ok = load_string(
+      "sensor:\n  type: mid360\nlink:\n  transport: dds\n  dds:\n    allow_multicast: false\n"
+      "    peers: [127.0.0.1]\n",
+      "t.yaml");
+  ASSERT_TRUE(ok.ok()) << joined(ok);
+  ASSERT_EQ(ok.params.link.dds.peers.size(), 1u);
+  EXPECT_EQ(ok.params.link.dds.peers[0], "127.0.0.1");
+}
+
+}  // namespace
+}  // namespace storey::config
