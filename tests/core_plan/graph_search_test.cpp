@@ -81,8 +81,11 @@ TEST(GraphSearch, BoundedDijkstraSettlesExactlyTheBall) {
       EXPECT_GE(st.dist, prev);  // settled in order of distance
       prev = st.dist;
     }
-    for (size_t v = 0; v < g.num_nodes(); ++v)  // nothing beyond the radius reports a distance
-      if (d[src][v] > r) EXPECT_EQ(s.dist(uint32_t(v)), kUnreachable);
+    for (size_t v = 0; v < g.num_nodes(); ++v) {  // nothing beyond the radius reports a distance
+      if (d[src][v] > r) {
+        EXPECT_EQ(s.dist(uint32_t(v)), kUnreachable);
+      }
+    }
   }
 }
 

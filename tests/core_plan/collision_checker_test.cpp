@@ -1,0 +1,130 @@
+#include "core/plan/collision_checker.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "tests/core_plan/voxel_world.hpp"
+
+namespace storey::core::plan {
+namespace {
+
+using storey::test::fill_voxels;
+
+std::vector<BodyPose> line_poses(Eigen::Vector3d a, Eigen::Vector3d b, double spacing, double yaw,
+                                 double pitch = 0) {
+  std::vector<BodyPose> p;
+  const int n = int(std::ceil((b - a).norm() / spacing));
+  for (int i = 0; i <= n; ++i) p.push_back({a + (b - a) * (double(i) / n), yaw, pitch, double(i)});
+  return p;
+}
+
+TEST(CollisionChecker, SpacingIsHalfTheSmallestBoxDimension) {
+  RobotModel robot;
+  CollisionChecker cc(robot, 0.1);
+  EXPECT_NEAR(cc.box_size_m().x(), 0.80, 1e-12);
+  EXPECT_NEAR(cc.box_size_m().y(), 0.41, 1e-12);
+  EXPECT_NEAR(cc.box_size_m().z(), 0.45, 1e-12);
+  EXPECT_NEAR(cc.max_sample_spacing_m(), 0.205, 1e-12);
+  EXPECT_LE(cc.max_dt_s() * robot.max_speed_mps, cc.max_sample_spacing_m() + 1e-12);
+}
+
+TEST(CollisionChecker, BoxInTheWayCollidesFloorDoesNot) {
+  CollisionChecker cc(RobotModel{}, 0.1);
+  std::vector<Eigen::Vector3f> vox;
+  fill_voxels(vox, {-2, -1, -0.1f}, {5, 1, 0});  // floor, surface at z = 0
+  const auto poses = line_poses({0, 0, 0}, {4, 0, 0}, 0.2, 0.0);
+  CollisionHit h = cc.check_poses(poses, vox);
+  EXPECT_FALSE(h.collides);
+  EXPECT_EQ(h.poses_checked, poses.size());
+  EXPECT_EQ(h.voxels_loaded, 0u);  // the floor is ground for every pose: not even loaded
+  fill_voxels(vox, {2.0f, -0.3f, 0}, {2.3f, 0.3f, 0.5f});  // a 0.3 m block on the path
+  h = cc.check_poses(poses, vox);
+  ASSERT_TRUE(h.collides);
+  // Body front (0.35 + margin 0.05 ahead of the foot point) reaches the block face (x = 2.0,
+  // first voxel centre 2.05 - 0.05 extent) between x = 1.6 and 1.65.
+  EXPECT_NEAR(poses[h.sample].foot_m.x(), 1.6, 0.2 + 1e-9);
+  EXPECT_GE(h.voxel_m.x(), 2.0);
+  // A low obstacle (below step height) is stepped over: ground.
+  std::vector<Eigen::Vector3f> curb;
+  fill_voxels(curb, {-2, -1, -0.1f}, {5, 1, 0});
+  fill_voxels(curb, {2.0f, -1, 0}, {2.2f, 1, 0.15f});
+  EXPECT_FALSE(cc.check_poses(poses, curb).collides);
+}
+
+TEST(CollisionChecker, ClearCorridorDoesNotCollideNarrowOneDoes) {
+  CollisionChecker cc(RobotModel{}, 0.1);
+  for (double half_gap : {0.35, 0.15}) {
+    std::vector<Eigen::Vector3f> vox;
+    fill_voxels(vox, {-1, -2, -0.1f}, {6, 2, 0});
+    fill_voxels(vox, {-1, float(half_gap), 0}, {6, float(half_gap) + 0.2f, 1.0f});
+    fill_voxels(vox, {-1, -float(half_gap) - 0.2f, 0}, {6, -float(half_gap), 1.0f});
+    const auto poses = line_poses({0, 0, 0}, {5, 0, 0}, 0.2, 0.0);
+    EXPECT_EQ(cc.check_poses(poses, vox).collides, half_gap < 0.2) << half_gap;
+    // Turning across the corridor (yaw 90 deg) makes the 0.8 m long box hit even the wide one.
+    const auto sideways = line_poses({0, 0, 0}, {5, 0, 0}, 0.2, M_PI / 2);
+    EXPECT_TRUE(cc.check_poses(sideways, vox).collides) << half_gap;
+  }
+}
+
+TEST(CollisionChecker, StairsUnderTheFeetAreNotCollisions) {
+  // 8 steps of 0.15 m rise, 0.30 m tread, solid, rising along +x from x = 0.
+  CollisionChecker cc(RobotModel{}, 0.1);
+  std::vector<Eigen::Vector3f> vox;
+  fill_voxels(vox, {-2, -1, -0.1f}, {0, 1, 0});
+  for (int i = 0; i < 8; ++i)
+    fill_voxels(vox, {0.3f * i, -1, -0.1f}, {0.3f * (i + 1), 1, 0.15f * (i + 1)});
+  fill_voxels(vox, {2.4f, -1, -0.1f}, {5, 1, 1.2f});  // landing
+  // Climbing along the flight's mid line (nosing-to-tread average), pitched with the slope.
+  const double pitch = std::atan2(0.15, 0.30);
+  std::vector<BodyPose> poses;
+  for (double x = 0.3; x <= 2.1; x += 0.1)
+    poses.push_back({{x, 0, 0.5 * x + 0.075}, 0.0, pitch, x});
+  CollisionHit h = cc.check_poses(poses, vox);
+  EXPECT_FALSE(h.collides) << "sample " << h.sample << " voxel " << h.voxel_m.transpose();
+  // The same flight taken level (no pitch) puts the upper treads into the body box.
+  for (auto& p : poses) p.pitch_rad = 0;
+  EXPECT_TRUE(cc.check_poses(poses, vox).collides);
+  // Stairs with a low beam overhead collide.
+  for (auto& p : poses) p.pitch_rad = pitch;
+  fill_voxels(vox, {1.0f, -1, 1.0f}, {1.2f, 1, 1.1f});
+  EXPECT_TRUE(cc.check_poses(poses, vox).collides);
+}
+
+TEST(CollisionChecker, NonFinitePoseIsReportedNotSafe) {
+  CollisionChecker cc(RobotModel{}, 0.1);
+  std::vector<Eigen::Vector3f> vox;
+  std::vector<BodyPose> poses{{{0, 0, 0}, 0}, {{std::nan(""), 0, 0}, 0}};
+  const CollisionHit h = cc.check_poses(poses, vox);
+  EXPECT_TRUE(h.collides);
+  EXPECT_TRUE(h.bad_input);
+  EXPECT_EQ(h.sample, 1u);
+}
+
+TEST(CollisionChecker, MapViewLookAheadAndSegments) {
+  // A room scanned by the synthetic LiDAR: floor, walls, and a pillar in the middle.
+  storey::test::World w;
+  w.add(storey::test::aabb({-4, -3, -0.2f}, {6, 3, 0}));
+  w.add(storey::test::aabb({-4, -3.2f, 0}, {6, -3, 2.5f}));
+  w.add(storey::test::aabb({-4, 3, 0}, {6, 3.2f, 2.5f}));
+  w.add(storey::test::aabb({2.0f, -0.3f, 0}, {2.4f, 0.3f, 2.5f}));  // pillar
+  map::TraversabilityMap m;
+  storey::test::scan_world(m, w, {{0, 0, 0.5f}, {0, 1.5f, 0.5f}});
+  const map::MapView view = m.view();
+  CollisionChecker cc(RobotModel{}, view.voxel_size_m());
+  // Straight into the pillar at 1 m/s: hit within the 2 s look-ahead, after ~1.6 s.
+  auto straight = [](double t) { return BodyPose{{t, 0, 0.0}, 0.0}; };
+  const CollisionHit h = cc.check_ahead(view, straight, 0.0, 2.0, 0.02);
+  ASSERT_TRUE(h.collides);
+  EXPECT_NEAR(h.t_s, 1.6, 0.1);
+  EXPECT_FALSE(cc.check_ahead(view, straight, 0.0, 1.0, 0.02).collides);  // 1 s: still clear
+  // Passing the pillar with 1 m of clearance does not collide.
+  auto offset = [](double t) { return BodyPose{{t, 1.5, 0.0}, 0.0}; };
+  EXPECT_FALSE(cc.check_ahead(view, offset, 0.0, 3.5, 0.02).collides);
+  EXPECT_TRUE(cc.check_segment(view, {0, 0, 0}, {3, 0, 0}, std::nan("")).collides);
+  EXPECT_FALSE(cc.check_segment(view, {0, 1.2, 0}, {3.5, 1.2, 0}, std::nan("")).collides);
+}
+
+}  // namespace
+}  // namespace storey::core::plan
