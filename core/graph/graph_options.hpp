@@ -1,26 +1,50 @@
 #pragma once
 // Parameters of the incremental reachable graph and topological frontiers (paper III-B, III-C).
+// Units in every name; paper symbols in the comments. Robot geometry (step height, body height,
+// width, margin) comes from core::RobotModel.
+#include <cstdint>
+
 namespace storey::core::graph {
 
 struct GraphOptions {
-  double r_e_m = 1.0;                  // r_e, Eq. 4 expansion radius
-  double node_clearance_m = 0.5;       // minimum distance between nodes (reuse existing)
-  int k_max = 8;                       // k_max, maximum node degree
+  double r_e_m = 1.0;             // r_e, Eq. 4 expansion radius
+  double node_clearance_m = 0.5;  // minimum distance between nodes (reuse existing)
+  int k_max = 8;                  // k_max, maximum node degree (<= ReachableGraph::kMaxDegree)
   double alpha_min_rad = 0.5235987755982988;  // alpha_min, 30 deg edge angular separation
-  int expansion_samples = 12;          // candidates theta ~ U(0, 2pi) per node and update
-  double rho_min = 0.3;                // rho_min, Eq. 5 missing-surface ratio threshold
-  double surface_radius_factor = 1.0;  // radius of Omega_i = factor * r_e
-  int probes = 12;                     // radial probes for C_exp
-  int theta_min = 2;                   // Theta_min, open directions for C_exp
-  double probe_length_m = 3.0;         // probe length for C_exp
-  int cluster_capacity = 8;            // maximum frontier nodes per cluster
-  int viewpoints_per_cluster = 8;      // K, best viewpoints kept per cluster
-  double viewpoint_radius_m = 2.5;     // candidate viewpoints from nodes within this radius
+  int expansion_samples = 12;                 // candidates theta ~ U(0, 2pi) per node and update
+  double rho_min = 0.3;                       // rho_min, Eq. 5 missing-surface ratio threshold
+  double surface_radius_factor = 1.0;         // radius of Omega_i = factor * r_e
+  int probes = 12;                            // radial probes for C_exp
+  int theta_min = 2;                          // Theta_min, open directions for C_exp
+  double probe_length_m = 3.0;                // probe length for C_exp
+  int cluster_capacity = 8;                   // maximum frontier nodes per cluster
+  int viewpoints_per_cluster = 8;             // K, best viewpoints kept per cluster
+  double viewpoint_radius_m = 2.5;            // candidate viewpoints from nodes within this radius
   // Ablation switches (paper Table III).
-  bool use_tentative = true;
-  bool use_c_sur = true;
-  bool use_c_exp = true;
-  bool boundary_frontiers = false;
+  bool use_tentative = true;        // false: "w/o tentative", graph restricted to C_reach
+  bool use_c_sur = true;            // false: "w/o surface criterion"
+  bool use_c_exp = true;            // false: "w/o expansion criterion"
+  bool boundary_frontiers = false;  // true: frontiers from the geometric boundary of C_reach
+
+  // --- graph geometry (Sec. III-B) ---
+  double neighbour_radius_factor = 1.6;  // a new node also links to nodes within factor * r_e
+  double max_edge_slope_rad = 0.6981317007977318;  // 40 deg: mean grade of an edge (stairs of
+                                                   // 0.17/0.28 m are ~31 deg)
+  double max_gap_m = 0.35;            // tentative edges may cross unknown (never observed) ground
+                                      // for at most this long (a sparsely observed gap)
+  double surface_tolerance_m = 0.03;  // slack on the step height for surface noise
+  double root_radius_m = 1.0;         // the robot's node: nearest within this, else a new one
+  double floor_height_hint_m = 3.0;   // floor id hint = round(z / this) (planning refines floors)
+  // --- incremental update budgets (bounded work per map cycle) ---
+  int max_expansions_per_update = 400;      // nodes expanded per update (queue carries over)
+  int max_revalidations_per_update = 2000;  // nodes (with their edges) re-checked per update
+  int max_frontier_updates = 1500;          // nodes whose frontier flags are recomputed per update
+  // --- frontiers (Sec. III-C) ---
+  int surface_samples = 32;        // |Omega_i|: samples of the disc, Eq. 5
+  double probe_height_m = 0.3;     // C_exp probes run this far above the node's support
+  double boundary_radius_m = 0.5;  // boundary ablation: C_reach boundary voxels this close
+  // --- viewpoints (Sec. III-C, last paragraph) ---
+  double viewpoint_target_height_m = 0.15;  // rays aim this far above a frontier node's support
 };
 
 }  // namespace storey::core::graph

@@ -1,0 +1,256 @@
+#include "core/graph/support_query.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include "core/map/voxel_ray.hpp"
+
+namespace storey::core::graph {
+
+using map::Cell;
+using map::Occupancy;
+using map::TravState;
+using map::VoxelKey;
+
+SupportQuery::SupportQuery(const map::MapView& view, const GraphOptions& opt)
+    : view_(view), reader_(view.store()), opt_(opt) {
+  occ_q_ = int16_t(std::lround(view.options().log_odds_occupied * map::kLogOddsScale));
+  vs_ = float(view.voxel_size_m());
+  inv_vs_ = 1.0f / vs_;
+  const RobotModel& r = view.robot();
+  step_ = float(r.step_height_m + opt.surface_tolerance_m);
+  clear_ = float(r.body_height_m + r.body_margin_m);
+  col_lo_ = float(r.step_height_m);
+  lateral_m_ = float(0.5 * r.body_width_m + r.body_margin_m);
+  tan_slope_ = float(std::tan(opt.max_edge_slope_rad));
+}
+
+int32_t SupportQuery::zkey(float z) const {
+  return int32_t(std::floor(z * inv_vs_));
+}
+
+Occupancy SupportQuery::occupancy(const VoxelKey& k) {
+  const Cell* c = cell(k);
+  if (!c || !(c->flags & Cell::kObserved)) return Occupancy::kUnknown;
+  return c->log_odds > occ_q_ ? Occupancy::kOccupied : Occupancy::kFree;
+}
+
+std::optional<Support> SupportQuery::surface_near(float x, float y, float z, float window) {
+  const int32_t cx = int32_t(std::floor(x * inv_vs_)), cy = int32_t(std::floor(y * inv_vs_));
+  const int32_t z_lo = zkey(z - window) - 1, z_hi = zkey(z + window) + 1;
+  std::optional<Support> best;
+  float best_d = std::numeric_limits<float>::infinity();
+  const Cell* top = cell({cx, cy, z_hi + 1});
+  bool above = occupied(top), above_free = free(top);
+  for (int32_t kz = z_hi; kz >= z_lo; --kz) {  // top-down so "voxel above" is known
+    const VoxelKey k{cx, cy, kz};
+    const Cell* c = cell(k);
+    const bool occ = occupied(c);
+    // Seen from above: the voxel over a walkable surface has been crossed by rays (observed
+    // free). A slab's underside seen from below has unknown space over it and is no support.
+    if (occ && !above && above_free) {
+      const map::VoxelStats* st = c->stats == Cell::kNoStats ? nullptr : reader_.stats(k);
+      const float h = (float(kz) + 0.5f) * vs_ + (st && st->count ? st->mean[2] : 0.0f);
+      const float d = std::abs(h - z);
+      if (d <= window && d < best_d) {
+        best_d = d;
+        best = Support{Eigen::Vector3f(x, y, h), k, c->state, bool(c->flags & Cell::kReachable),
+                       st ? st->cost : 0.0f};
+      }
+    }
+    above = occ;
+    above_free = free(c);
+  }
+  return best;
+}
+
+namespace {
+int rank(const Support& s) {
+  if (s.reachable) return 3;
+  switch (s.state) {
+    case TravState::kTraversable:
+      return 2;
+    case TravState::kUnobserved:
+      return 1;
+    default:
+      return 0;
+  }
+}
+}  // namespace
+
+std::optional<Support> SupportQuery::support_dilated(float x, float y, float z, float window) {
+  std::optional<Support> best = surface_near(x, y, z, window);
+  if (best && best->reachable) return best;
+  int best_rank = best ? rank(*best) : -1;
+  float best_d = best ? std::abs(best->p_m.z() - z) : 0.0f;
+  for (int dx = -1; dx <= 1; ++dx)
+    for (int dy = -1; dy <= 1; ++dy) {
+      if (dx == 0 && dy == 0) continue;
+      const std::optional<Support> s =
+          surface_near(x + float(dx) * vs_, y + float(dy) * vs_, z, window);
+      if (!s) continue;
+      const int r = rank(*s);
+      const float d = std::abs(s->p_m.z() - z);
+      if (r > best_rank || (r == best_rank && d < best_d)) {
+        best = s;
+        best_rank = r;
+        best_d = d;
+      }
+    }
+  if (best) {
+    best->p_m.x() = x;
+    best->p_m.y() = y;
+  }
+  return best;
+}
+
+bool SupportQuery::body_clear(float x, float y, float h, const Eigen::Vector2f& lateral) {
+  // Heights of occupied voxels by their points' mean (as R_col in the map, Eq. 3), so a stair
+  // nose one step up that shares a voxel layer with the clearance band does not count.
+  const int32_t z_lo = zkey(h + col_lo_) - 1, z_hi = zkey(h + clear_);
+  for (int side = -1; side <= 1; ++side) {
+    const float px = x + float(side) * lateral.x() * lateral_m_;
+    const float py = y + float(side) * lateral.y() * lateral_m_;
+    const int32_t cx = int32_t(std::floor(px * inv_vs_)), cy = int32_t(std::floor(py * inv_vs_));
+    for (int32_t kz = z_lo; kz <= z_hi; ++kz) {
+      const VoxelKey k{cx, cy, kz};
+      const Cell* c = cell(k);
+      if (!occupied(c)) continue;
+      const map::VoxelStats* st = c->stats == Cell::kNoStats ? nullptr : reader_.stats(k);
+      const float hv = (float(kz) + 0.5f) * vs_ + (st && st->count ? st->mean[2] : 0.0f);
+      if (hv > h + col_lo_ && hv <= h + clear_) return false;
+    }
+  }
+  return true;
+}
+
+bool SupportQuery::fall_risk(const Eigen::Vector3f& p) {
+  int drops = 0;
+  for (int i = 0; i < 8; ++i) {
+    const float a = float(i) * float(M_PI) / 4.0f;
+    const float x = p.x() + lateral_m_ * std::cos(a), y = p.y() + lateral_m_ * std::sin(a);
+    if (surface_near(x, y, p.z(), step_)) continue;
+    const int32_t cx = int32_t(std::floor(x * inv_vs_)), cy = int32_t(std::floor(y * inv_vs_));
+    // Observed free at the surface level and one step below: nothing to stand on.
+    const int32_t kz = zkey(p.z());
+    if (free(cell({cx, cy, kz})) && free(cell({cx, cy, zkey(p.z() - step_)}))) ++drops;
+  }
+  return drops >= 2;
+}
+
+map::Occupancy SupportQuery::walk(const Eigen::Vector3f& from, const Eigen::Vector3f& to,
+                                  bool stop_at_unknown, float* free_m) {
+  const map::VoxelKey start{int32_t(std::floor(from.x() * inv_vs_)),
+                            int32_t(std::floor(from.y() * inv_vs_)),
+                            int32_t(std::floor(from.z() * inv_vs_))};
+  Occupancy result = Occupancy::kFree;
+  uint32_t steps = 0;
+  auto visit = [&](const VoxelKey& k) {
+    if (k == start) return true;
+    const Occupancy o = occupancy(k);
+    if (o == Occupancy::kFree || (o == Occupancy::kUnknown && !stop_at_unknown)) {
+      ++steps;
+      return true;
+    }
+    result = o;
+    return false;
+  };
+  const uint32_t n = map::walk_ray(from.x() * inv_vs_, from.y() * inv_vs_, from.z() * inv_vs_,
+                                   to.x() * inv_vs_, to.y() * inv_vs_, to.z() * inv_vs_, visit);
+  if (result == Occupancy::kFree) {  // walk_ray stops before the end voxel
+    const VoxelKey e{int32_t(std::floor(to.x() * inv_vs_)), int32_t(std::floor(to.y() * inv_vs_)),
+                     int32_t(std::floor(to.z() * inv_vs_))};
+    if (!(e == start)) visit(e);
+  }
+  if (free_m) {
+    const float len = (to - from).norm();
+    *free_m = n ? len * float(steps) / float(n + 1) : 0.0f;
+  }
+  return result;
+}
+
+Reject SupportQuery::classify_node(const Support& s, bool* confirmed) {
+  *confirmed = false;
+  if (s.state == TravState::kUntraversable || s.state == TravState::kNone)
+    return Reject::kUntraversable;
+  if (!body_clear(s.p_m.x(), s.p_m.y(), s.p_m.z(), Eigen::Vector2f(1, 0)) ||
+      !body_clear(s.p_m.x(), s.p_m.y(), s.p_m.z(), Eigen::Vector2f(0, 1)))
+    return Reject::kCollision;
+  if (s.reachable) {  // C_reach already excludes R_col and R_fall (Eq. 3)
+    *confirmed = true;
+    return Reject::kNone;
+  }
+  // Tentative: collision-free and free of fall risk over under-observed ground (Sec. III-B).
+  if (fall_risk(s.p_m)) return Reject::kFallRisk;
+  return opt_.use_tentative ? Reject::kNone : Reject::kNotReachable;
+}
+
+EdgeCheck SupportQuery::check_edge(const Eigen::Vector3f& a, const Eigen::Vector3f& b) {
+  EdgeCheck out;
+  const Eigen::Vector2f d(b.x() - a.x(), b.y() - a.y());
+  const float L = d.norm();
+  const float dz = b.z() - a.z();
+  if (std::abs(dz) > step_ && std::abs(dz) > tan_slope_ * L) {
+    out.reject = Reject::kSlope;
+    return out;
+  }
+  const Eigen::Vector2f lat =
+      L > 1e-6f ? Eigen::Vector2f(-d.y() / L, d.x() / L) : Eigen::Vector2f(1, 0);
+  const int n = std::max(1, int(std::ceil(L * inv_vs_)));
+  bool reach = true;
+  float z = a.z(), gap = 0, cost_sum = 0, len = 0;
+  int supported = 0;
+  Eigen::Vector3f prev = a;
+  for (int k = 1; k < n; ++k) {
+    const float t = float(k) / float(n);
+    const float x = a.x() + d.x() * t, y = a.y() + d.y() * t;
+    const std::optional<Support> s = support_dilated(x, y, z, step_);
+    if (s) {
+      if (s->state == TravState::kUntraversable) {
+        out.reject = Reject::kUntraversable;
+        return out;
+      }
+      if (!body_clear(x, y, s->p_m.z(), lat)) {
+        out.reject = Reject::kCollision;
+        return out;
+      }
+      reach = reach && s->reachable;
+      cost_sum += s->cost;
+      ++supported;
+      z = s->p_m.z();
+      gap = 0;
+    } else {
+      // No support within a step of the previous sample: a wall, a drop, or unknown ground.
+      if (!body_clear(x, y, z, lat)) {
+        out.reject = Reject::kCollision;
+        return out;
+      }
+      const int32_t cx = int32_t(std::floor(x * inv_vs_)), cy = int32_t(std::floor(y * inv_vs_));
+      if (free(cell({cx, cy, zkey(z)})) && free(cell({cx, cy, zkey(z - step_)}))) {
+        out.reject = Reject::kFallRisk;
+        return out;
+      }
+      // Unknown ground: only tentative elements may bridge it, and only briefly.
+      reach = false;
+      gap += L / float(n);
+      if (gap > float(opt_.max_gap_m)) {
+        out.reject = Reject::kGap;
+        return out;
+      }
+    }
+    const Eigen::Vector3f cur(x, y, z);
+    len += (cur - prev).norm();
+    prev = cur;
+  }
+  if (std::abs(b.z() - z) > step_) {
+    out.reject = Reject::kStep;
+    return out;
+  }
+  len += (b - prev).norm();
+  out.all_reachable = reach;
+  out.length_m = len;
+  out.mean_cost = supported ? cost_sum / float(supported) : 0.0f;
+  return out;
+}
+
+}  // namespace storey::core::graph

@@ -1,0 +1,57 @@
+#pragma once
+// Topological frontiers on the nodes of G_real (paper Sec. III-C):
+//   C_sur(n_i): rho_i = 1 - (1/|Omega_i|) sum_x I(x, z_i) >= rho_min (Eq. 5), Omega_i a disc of
+//               radius surface_radius_factor * r_e around the node;
+//   C_exp(n_i): |Theta_i^open| >= Theta_min, radial probes along directions not covered by
+//               edges, open if they cross known free space and reach unknown without obstacle;
+//   n_i in V_TF <=> C_sur or C_exp (each switchable for the ablations).
+// Ablation "boundary frontiers": a node is a frontier iff a voxel of the geometric boundary of
+// C_reach (a reachable voxel with an unknown / unobserved neighbour column) lies within
+// boundary_radius_m of it.
+//
+// Incremental: only nodes the graph touched and nodes near changed map regions are
+// re-evaluated, at most max_frontier_updates per update (nearest the robot first); the rest
+// carries over.
+#include <cstdint>
+#include <deque>
+#include <span>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/graph/reachable_graph.hpp"
+
+namespace storey::core::graph {
+
+struct FrontierUpdateStats {
+  uint32_t evaluated = 0;
+  uint32_t frontiers = 0;  // |V_TF| after the update
+  uint32_t c_sur = 0, c_exp = 0, boundary = 0;
+  uint32_t pending = 0;
+};
+
+class TopologicalFrontiers {
+ public:
+  explicit TopologicalFrontiers(const GraphOptions& opt = {});
+
+  FrontierUpdateStats update(ReachableGraph& g, const map::MapView& view,
+                             const Eigen::Vector3f& robot_m, std::span<const Aabb> changed);
+  // Evaluates one node now (also used by tests): writes rho, open_dirs and the flags.
+  void evaluate(ReachableGraph& g, const map::MapView& view, NodeId i);
+  bool idle() const { return queue_.empty(); }
+
+ private:
+  float missing_surface_ratio(SupportQuery& q, const GraphNode& n, int* samples);  // Eq. 5
+  int open_directions(SupportQuery& q, const ReachableGraph& g, NodeId i);
+  bool near_reach_boundary(SupportQuery& q, const GraphNode& n);
+  void evaluate(ReachableGraph& g, SupportQuery& q, NodeId i);
+
+  GraphOptions opt_;
+  std::vector<Eigen::Vector2f> disc_;  // Omega_i sample offsets (unit disc, sunflower pattern)
+  std::deque<NodeId> queue_;
+  std::vector<uint8_t> queued_;
+  std::vector<NodeId> scratch_;
+  std::vector<uint8_t> cls_;
+};
+
+}  // namespace storey::core::graph

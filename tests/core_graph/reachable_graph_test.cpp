@@ -1,0 +1,168 @@
+// G_real (paper Sec. III-B): multi-floor connectivity, states, pruning, determinism.
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <map>
+#include <queue>
+#include <set>
+
+#include <gtest/gtest.h>
+
+#include "core/graph/reachable_graph.hpp"
+#include "tests/core_graph/graph_world.hpp"
+
+using namespace storey::core::graph;
+using Eigen::Vector3f;
+using storey::test::graph::Harness;
+using storey::test::graph::World;
+
+namespace {
+
+constexpr float kRise = 3.0f / 18.f, kTread = 0.28f;
+
+// Two storeys 3 m apart (slab tops 0.03 and 3.03 m) joined by a straight flight of 18 steps of
+// 0.167 m under a stairwell opening (x in [-2, 3.04], y in [2.6, 4]).
+World two_floor_building() {
+  World w;
+  w.add({-6, -4, -0.3f}, {6, 4, 0.03f});     // ground slab
+  w.add({-6, -4, 2.83f}, {6, 2.6f, 3.03f});  // upper slab with the stairwell hole
+  w.add({-6, 2.6f, 2.83f}, {-2, 4, 3.03f});
+  w.add({3.04f, 2.6f, 2.83f}, {6, 4, 3.03f});
+  w.stairs(-2.0f, 2.7f, 3.9f, 0.03f, 18, kRise, kTread);
+  w.add({-6.2f, -4.2f, -0.3f}, {-6, 4.2f, 6});  // outer walls
+  w.add({6, -4.2f, -0.3f}, {6.2f, 4.2f, 6});
+  w.add({-6, -4.2f, -0.3f}, {6, -4, 6});
+  w.add({-6, 4, -0.3f}, {6, 4.2f, 6});
+  w.add({-6, 2.5f, 0.03f}, {-2.5f, 2.6f, 2.83f});  // wall beside the stairs, ground floor
+  return w;
+}
+
+// Top of the highest box within 0.1 m (one voxel) of (x, y) whose top is at most z_max: the
+// analytic support height, tolerant to the map's discretisation at box borders.
+float support_height(const World& w, float x, float y, float z_max) {
+  float best = -1e9f;
+  for (const auto& b : w.boxes)
+    if (x >= b.lo.x() - 0.1f && x <= b.hi.x() + 0.1f && y >= b.lo.y() - 0.1f &&
+        y <= b.hi.y() + 0.1f && b.hi.z() <= z_max)
+      best = std::max(best, b.hi.z());
+  return best;
+}
+
+void explore_two_floors(Harness& h, const World& w) {
+  std::vector<std::pair<Vector3f, Vector3f>> path;  // (sensor, foot)
+  auto at = [&](float x, float y, float ground) {
+    path.push_back({Vector3f(x, y, ground + 0.52f), Vector3f(x, y, ground)});
+  };
+  for (float x : {-4.f, -1.f, 2.f, 4.f}) at(x, 0, 0.03f);
+  at(-3, 3.3f, 0.03f);
+  for (int i = 0; i < 18; i += 3) at(-2.0f + (i + 0.5f) * kTread, 3.3f, 0.03f + (i + 1) * kRise);
+  for (float x : {4.5f, 4.f, 0.f, -4.f}) at(x, x == 4.5f ? 3.3f : 0.f, 3.03f);
+  uint32_t seed = 1;
+  for (const auto& [s, f] : path) h.observe(w, s, f, 60000, seed++);
+}
+
+// Node ids reachable from `from` over edges (BFS), with parents.
+std::map<NodeId, NodeId> bfs_tree(const ReachableGraph& g, NodeId from) {
+  std::map<NodeId, NodeId> parent{{from, from}};
+  std::queue<NodeId> q;
+  q.push(from);
+  while (!q.empty()) {
+    const NodeId u = q.front();
+    q.pop();
+    const GraphNode& n = g.node(u);
+    for (int k = 0; k < n.degree; ++k) {
+      const NodeId v = g.edge(n.edges[k]).other(u);
+      if (parent.emplace(v, u).second) q.push(v);
+    }
+  }
+  return parent;
+}
+
+void dump(const ReachableGraph& g) {
+  if (!getenv("STOREY_DEBUG")) return;
+  for (NodeId i = 0; i < g.node_capacity(); ++i) {
+    const GraphNode& n = g.node(i);
+    if (n.alive)
+      printf("node %u %.2f %.2f %.2f s%d deg %d\n", i, n.p_m.x(), n.p_m.y(), n.p_m.z(),
+             int(n.state), n.degree);
+  }
+}
+
+}  // namespace
+
+TEST(ReachableGraph, ConnectsFloorsThroughStairsNeverThroughSlab) {
+  const World w = two_floor_building();
+  Harness h;
+  explore_two_floors(h, w);
+  const ReachableGraph& g = h.graph;
+  dump(g);
+  ASSERT_GT(g.node_count(), 60u);
+  int lower = 0, upper = 0;
+  NodeId a_low = kNoId, a_up = kNoId;
+  for (NodeId i = 0; i < g.node_capacity(); ++i) {
+    const GraphNode& n = g.node(i);
+    if (!n.alive) continue;
+    // Every node stands on a real surface (the analytic support under it).
+    EXPECT_NEAR(n.p_m.z(), support_height(w, n.p_m.x(), n.p_m.y(), n.p_m.z() + 0.1f), 0.06f)
+        << "node " << i << " at " << n.p_m.transpose();
+    if (std::abs(n.p_m.z() - 0.03f) < 0.05f && n.p_m.y() < 2.4f) {
+      ++lower;
+      if (a_low == kNoId) a_low = i;
+    }
+    if (std::abs(n.p_m.z() - 3.03f) < 0.05f && n.p_m.y() < 2.4f) {
+      ++upper;
+      if (a_up == kNoId) a_up = i;
+    }
+  }
+  EXPECT_GT(lower, 25);
+  EXPECT_GT(upper, 25);
+  // Every edge is a walk over the analytic surface in steps no higher than a stair step.
+  for (EdgeId e = 0; e < g.edge_capacity(); ++e) {
+    const GraphEdge& ge = g.edge(e);
+    if (!ge.alive) continue;
+    const Vector3f a = g.node(ge.a).p_m, b = g.node(ge.b).p_m;
+    float z = a.z();
+    for (int k = 1; k <= 40; ++k) {
+      const Vector3f p = a + (b - a) * (float(k) / 40.f);
+      const float s = support_height(w, p.x(), p.y(), z + 0.2f);
+      EXPECT_LE(std::abs(s - z), 0.2f) << "edge " << e << " " << a.transpose() << " -> "
+                                       << b.transpose() << " jumps at " << p.transpose();
+      z = s;
+    }
+  }
+  // The floors are connected, and only through the flight of stairs.
+  ASSERT_NE(a_low, kNoId);
+  ASSERT_NE(a_up, kNoId);
+  const auto tree = bfs_tree(g, a_low);
+  ASSERT_TRUE(tree.count(a_up)) << "upper floor not connected to the ground floor";
+  bool via_stairs = false;
+  for (NodeId v = a_up; v != a_low; v = tree.at(v)) {
+    const Vector3f p = g.node(v).p_m;
+    if (p.z() > 0.5f && p.z() < 2.6f) {
+      via_stairs = true;
+      EXPECT_GT(p.x(), -2.1f);
+      EXPECT_LT(p.x(), 3.1f);
+      EXPECT_GT(p.y(), 2.6f);
+    }
+  }
+  EXPECT_TRUE(via_stairs);
+}
+
+TEST(ReachableGraph, SameSeedSameGraph) {
+  const World w = two_floor_building();
+  auto run = [&](uint64_t seed) {
+    Harness h({}, seed);
+    for (int i = 0; i < 3; ++i)
+      h.observe(w, Vector3f(-4 + 3 * i, 0, 0.55f), Vector3f(-4 + 3 * i, 0, 0.03f), 40000, i + 1);
+    std::vector<float> sig;
+    for (NodeId n = 0; n < h.graph.node_capacity(); ++n) {
+      const GraphNode& gn = h.graph.node(n);
+      sig.push_back(gn.alive ? gn.p_m.x() + 100 * gn.p_m.y() + 1e4f * gn.p_m.z() : -1.f);
+      sig.push_back(float(gn.degree));
+    }
+    return sig;
+  };
+  const auto a = run(7), b = run(7), c = run(8);
+  EXPECT_EQ(a, b);
+  EXPECT_NE(a, c);
+}
