@@ -8,6 +8,8 @@
 #include <mutex>
 #include <thread>
 
+#include <time.h>
+
 #include "rt/rt_setup.hpp"
 #include "rt/spsc_queue.hpp"
 
@@ -59,6 +61,12 @@ struct Backoff {
 // items_per_second on the wall clock (two threads work; the main thread's CPU time would
 // flatter whichever queue sleeps more). Set as a plain counter so the names stay exactly
 // <what>/storey and <what>/mutex_deque (UseRealTime() would append "/real_time").
+double thread_cpu_s() {
+  timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
 void set_rate(benchmark::State& state, double items, std::chrono::steady_clock::time_point t0) {
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   state.counters["items_per_second"] = items / s;
@@ -71,8 +79,10 @@ void spsc_throughput(benchmark::State& state) {
   Q q(kCapacity);
   storey::rt::pin_cpu(0);
   std::uint64_t received = 0;
+  double consumer_cpu = 0;
   std::thread consumer([&] {
     storey::rt::pin_cpu(1);
+    const double c0 = thread_cpu_s();
     std::uint64_t v = 0;
     Backoff wait;
     for (;;) {
@@ -84,18 +94,25 @@ void spsc_throughput(benchmark::State& state) {
       benchmark::DoNotOptimize(v);
       ++received;
     }
+    consumer_cpu = thread_cpu_s() - c0;
   });
   Backoff wait;
   const auto t0 = std::chrono::steady_clock::now();
+  const double p0 = thread_cpu_s();
   for (auto _ : state) {
     for (std::uint64_t i = 0; i < kBatch; ++i) {
       while (!q.try_push(i)) wait();
     }
   }
   while (!q.try_push(kStop)) wait();
+  const double producer_cpu = thread_cpu_s() - p0;
   consumer.join();
   if (received != state.iterations() * kBatch) state.SkipWithError("items lost");
-  set_rate(state, static_cast<double>(state.iterations() * kBatch), t0);
+  const double items = static_cast<double>(state.iterations() * kBatch);
+  set_rate(state, items, t0);
+  // CPU spent by both threads per item (including waiting): the cost of the queue, much less
+  // sensitive than the wall-clock rate to whether the OS runs both threads at once.
+  state.counters["cpu_ns_per_item"] = (producer_cpu + consumer_cpu) * 1e9 / items;
 }
 
 // One item to the echo thread and back per iteration: Time is the round-trip latency.
