@@ -18,13 +18,15 @@ struct CollisionChecker::Impl {
   // Voxel objects are pooled and re-positioned, never re-created once the pool has grown.
   std::vector<std::unique_ptr<fcl::CollisionObjectd>> pool;
   std::vector<fcl::CollisionObjectd*> active;
+  std::vector<float> surface_z;  // parallel to active
   fcl::DynamicAABBTreeCollisionManagerd manager;
 };
 
 namespace {
 struct QueryData {
   const fcl::CollisionObjectd* body;
-  Eigen::Matrix3d r;  // body -> world rotation
+  const float* surface_z;  // per loaded voxel: mean height of its points (ground test)
+  Eigen::Matrix3d r;       // body -> world rotation
   Eigen::Vector3d foot;
   double step;  // voxel centres less than this above the bottom face are ground
   bool hit = false;
@@ -34,8 +36,10 @@ struct QueryData {
 bool on_pair(fcl::CollisionObjectd* o1, fcl::CollisionObjectd* o2, void* data) {
   auto* q = static_cast<QueryData*>(data);
   const fcl::CollisionObjectd* vox = o1 == q->body ? o2 : o1;
-  const Eigen::Vector3d c = vox->getTranslation();
+  Eigen::Vector3d c = vox->getTranslation();
+  c.z() = q->surface_z[reinterpret_cast<uintptr_t>(vox->getUserData())];
   if ((q->r.transpose() * (c - q->foot)).z() < q->step) return false;  // ground: keep looking
+  c = vox->getTranslation();
   fcl::CollisionRequestd req;
   fcl::CollisionResultd res;
   if (fcl::collide(o1, o2, req, res) == 0) return false;
@@ -80,17 +84,22 @@ double CollisionChecker::max_dt_s() const {
 }
 
 void CollisionChecker::load_voxels(std::span<const Eigen::Vector3f> centres,
-                                   double ground_below_z) {
+                                   std::span<const float> surface_z, double ground_below_z) {
   Impl& im = *impl_;
   im.manager.clear();
   im.active.clear();
-  for (const Eigen::Vector3f& c : centres) {
-    if (double(c.z()) < ground_below_z) continue;  // ground for every pose of this group
+  im.surface_z.clear();
+  for (size_t k = 0; k < centres.size(); ++k) {
+    const Eigen::Vector3f& c = centres[k];
+    const float zs = k < surface_z.size() ? surface_z[k] : c.z();
+    if (double(zs) < ground_below_z) continue;  // ground for every pose of this group
     const size_t i = im.active.size();
     if (i == im.pool.size())
       im.pool.push_back(std::make_unique<fcl::CollisionObjectd>(im.voxel_geom));
     fcl::CollisionObjectd* o = im.pool[i].get();
     o->setTranslation(c.cast<double>());
+    o->setUserData(reinterpret_cast<void*>(uintptr_t(i)));
+    im.surface_z.push_back(zs);
     o->computeAABB();
     im.active.push_back(o);
   }
@@ -110,7 +119,7 @@ bool CollisionChecker::collide_one(const BodyPose& p, Eigen::Vector3d* voxel) {
   const Eigen::Matrix3d r = body_rotation(p);
   im.body->setTransform(r, p.foot_m + r * Eigen::Vector3d(0, 0, 0.5 * box_m_.z()));
   im.body->computeAABB();
-  QueryData q{im.body.get(), r, p.foot_m, robot_.step_height_m};
+  QueryData q{im.body.get(), im.surface_z.data(), r, p.foot_m, robot_.step_height_m};
   im.manager.collide(im.body.get(), &q, on_pair);
   if (q.hit && voxel) *voxel = q.voxel;
   return q.hit;
@@ -129,7 +138,7 @@ CollisionHit CollisionChecker::check_poses(std::span<const BodyPose> poses,
     }
     ground = std::min(ground, ground_floor_z(poses[i]));
   }
-  load_voxels(voxel_centres_m, ground);
+  load_voxels(voxel_centres_m, {}, ground);
   h.voxels_loaded = uint32_t(impl_->active.size());
   for (size_t i = 0; i < poses.size(); ++i) {
     ++h.poses_checked;
@@ -176,7 +185,10 @@ CollisionHit CollisionChecker::check_poses(const map::MapView& view,
     centres_.clear();
     view.occupied_in_box(((blo + bhi) * 0.5).cast<float>(), ((bhi - blo) * 0.5).cast<float>(),
                          centres_);
-    load_voxels(centres_, ground);
+    surface_z_.clear();
+    for (const Eigen::Vector3f& c : centres_)
+      surface_z_.push_back(view.surface_height_m(view.key_of(c)).value_or(c.z()));
+    load_voxels(centres_, surface_z_, ground);
     h.voxels_loaded += uint32_t(impl_->active.size());
     for (size_t k = i; k < j; ++k) {
       ++h.poses_checked;

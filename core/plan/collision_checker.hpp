@@ -7,8 +7,9 @@
 // Body: an oriented box (RobotModel length x width + 2 * margin, height body_height + margin),
 // rotated by yaw and by the pitch of the terrain along the path (nose up when climbing), its
 // bottom face centred on the support point of the pose (support height h).
-// Ground rule: an occupied voxel whose centre lies less than step_height_m above the body's
-// bottom face (measured in the body frame: on flat ground, centre z < h + step_height_m) is
+// Ground rule: an occupied voxel whose surface point (voxel centre x, y at the mean height of its
+// points; the centre for voxel lists without statistics) lies less than step_height_m above the
+// body's bottom face (body frame; on flat ground: z < h + step_height_m) is
 // ground the legs stand on or step over (floor, stair treads, curbs), not an obstacle; every
 // other occupied voxel overlapping the box is a collision. Pitching with the slope is what lets
 // stairs pass: a 30 deg flight rises 0.23 m within the body's half length.
@@ -98,7 +99,8 @@ class CollisionChecker {
  private:
   struct Impl;
   bool collide_one(const BodyPose& p, Eigen::Vector3d* voxel);
-  void load_voxels(std::span<const Eigen::Vector3f> centres, double ground_below_z);
+  void load_voxels(std::span<const Eigen::Vector3f> centres, std::span<const float> surface_z,
+                   double ground_below_z);
   // World z below which a voxel centre is ground for pose p wherever it is under the body.
   double ground_floor_z(const BodyPose& p) const;
 
@@ -110,6 +112,7 @@ class CollisionChecker {
   std::unique_ptr<Impl> impl_;
   std::vector<BodyPose> samples_;
   std::vector<Eigen::Vector3f> centres_;
+  std::vector<float> surface_z_;
 };
 
 }  // namespace storey::core::plan
