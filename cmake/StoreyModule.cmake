@@ -32,5 +32,7 @@ function(storey_test_dir name)
   target_compile_definitions(test_${name} PRIVATE STOREY_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
                              STOREY_BINARY_DIR="${PROJECT_BINARY_DIR}")
   set(labels unit ${T_LABELS})
+  # The list goes through a generated script: escape its separators or only "unit" survives.
+  string(REPLACE ";" "\\;" labels "${labels}")
   gtest_discover_tests(test_${name} PROPERTIES LABELS "${labels}" DISCOVERY_TIMEOUT 60)
 endfunction()
