@@ -13,6 +13,11 @@ struct MapOptions {
   float log_odds_min = -2.0f;   // clamping (keeps the map able to change)
   float log_odds_max = 3.5f;
   float log_odds_occupied = 0.0f;  // occupied above this
+  int ray_early_stop_voxels = 4;   // rays are cast from the endpoint back to the sensor and
+                                   // stop after this many consecutive voxels already updated
+                                   // in this scan (near the sensor every ray overlaps the
+                                   // others; voxblox's "fast" integrator). 0: exact, every
+                                   // voxel of every ray.
   // --- terrain statistics, Eq. 1-3 ---
   int n_min = 5;                        // N_min, Eq. 3: fewer points in v -> S_unobs
   double neighbourhood_radius_m = 0.2;  // aggregation radius for Eq. 1 (horizontal)

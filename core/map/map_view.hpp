@@ -17,20 +17,25 @@
 
 namespace storey::core::map {
 
-// Caches the last block looked up. Invalidation: holds a raw pointer into `store`; it must not
-// outlive a write to `store` (the owner's copy-on-write may swap the block behind a key).
-// Every MapView query builds its own BlockReader, so views never hold stale pointers.
+// Caches the last 16 blocks looked up (direct-mapped by block coordinate, so neighbourhood
+// scans that straddle block borders stay off the hash table). Invalidation: holds raw pointers
+// into `store`; it must not outlive a write to `store` (the owner's copy-on-write may swap the
+// block behind a key). Every MapView query builds its own BlockReader, so views never hold
+// stale pointers; the owner calls invalidate() whenever a write cloned a block.
 class BlockReader {
  public:
   explicit BlockReader(const BlockStore& store) : store_(&store) {}
   const VoxelBlock* block(const VoxelKey& k) {
     const uint64_t bk = block_key_of(k);
-    if (bk != key_ || !valid_) {
-      key_ = bk;
-      block_ = store_->find(bk);
-      valid_ = true;
+    const int slot = ((k.x >> kBlockBits) & 3) | (((k.y >> kBlockBits) & 1) << 2) |
+                     (((k.z >> kBlockBits) & 1) << 3);
+    Entry& e = cache_[slot];
+    if (!e.valid || e.key != bk) {
+      e.key = bk;
+      e.block = store_->find(bk);
+      e.valid = true;
     }
-    return block_;
+    return e.block;
   }
   const Cell* cell(const VoxelKey& k) {
     const VoxelBlock* b = block(k);
@@ -43,13 +48,18 @@ class BlockReader {
     const Cell& c = b->cells[cell_index(k)];
     return c.stats == Cell::kNoStats ? nullptr : &b->stats[c.stats];
   }
-  void invalidate() { valid_ = false; }
+  void invalidate() {
+    for (Entry& e : cache_) e.valid = false;
+  }
 
  private:
+  struct Entry {
+    uint64_t key = 0;
+    const VoxelBlock* block = nullptr;
+    bool valid = false;
+  };
   const BlockStore* store_;
-  uint64_t key_ = 0;
-  const VoxelBlock* block_ = nullptr;
-  bool valid_ = false;
+  Entry cache_[16];
 };
 
 // A support voxel found near a query point.

@@ -159,10 +159,15 @@ InsertStats TraversabilityMap::insert_scan(const Eigen::Vector3f& o,
     return delta.dot(cov.inverse() * delta) <= 9.0;  // closed-form 3x3 inverse
   };
   // Pass 2: free space along each de-duplicated ray.
+  const int early_stop = opt_.ray_early_stop_voxels;
+  int run = 0;  // consecutive voxels of the current ray already updated in this scan
   auto miss = [&](const VoxelKey& k) {
     VoxelBlock* b = wblock(k, true);
     const int idx = cell_index(k);
-    if (b->test_and_set_touched(idx)) return true;  // already hit or missed in this scan
+    if (b->test_and_set_touched(idx)) {  // already hit or missed in this scan
+      return early_stop <= 0 || ++run < early_stop;
+    }
+    run = 0;
     Cell& c = b->cells[idx];
     const bool was_occ = occupied(&c);
     if (was_occ && c.stats != Cell::kNoStats && !ray_meets_points(k, b->stats[c.stats]))
@@ -175,6 +180,8 @@ InsertStats TraversabilityMap::insert_scan(const Eigen::Vector3f& o,
     }
     return true;
   };
+  ray_dir = Eigen::Vector3d::UnitZ();
+  miss(floor_key(ox, oy, oz));  // the sensor is in free space
   for (uint32_t e : ray_points_) {
     const bool truncated = e & kTruncated;
     const Eigen::Vector3f& p = pts[e & ~kTruncated];
@@ -186,8 +193,11 @@ InsertStats TraversabilityMap::insert_scan(const Eigen::Vector3f& o,
       ez = oz + (ez - oz) * f;
     }
     ray_dir = Eigen::Vector3d(ex - ox, ey - oy, ez - oz).normalized();
-    st.voxels_walked += walk_ray(ox, oy, oz, ex, ey, ez, miss);
-    if (truncated) miss(floor_key(ex, ey, ez));
+    // Endpoint -> sensor: the voxels unique to this ray come first, the shared ones last.
+    // Visits the endpoint voxel (already hit, or the max-range voxel of a truncated ray) and
+    // stops before the sensor's voxel, which is cleared once per scan above.
+    run = 0;
+    st.voxels_walked += walk_ray(ex, ey, ez, ox, oy, oz, miss);
     ++st.rays_cast;
   }
   st.changed = uint32_t(changed_.size());

@@ -22,6 +22,7 @@ MapOptions opts() {
   o.voxel_size_m = 0.1;
   o.min_range_m = 0.3;
   o.max_range_m = 10.0;
+  o.ray_early_stop_voxels = 0;  // exact ray casting: every voxel of every ray
   return o;
 }
 int16_t q(float lo) {
@@ -228,4 +229,38 @@ TEST(TraversabilityMap, PlyExportWritesEveryOccupiedVoxel) {
   EXPECT_NE(bad.error.find("/nonexistent-dir/x.ply"), std::string::npos);
   std::remove(path.c_str());
   std::remove((path + ".reach.ply").c_str());
+}
+
+TEST(TraversabilityMap, EarlyStopRayCastingIsASubsetOfExact) {
+  // ray_early_stop_voxels > 0 skips only voxels other rays of the same scan already updated:
+  // same occupied voxels, free voxels a subset of the exact ones, and nearly all of them.
+  const storey::test::World w = storey::test::office_box_world();
+  MapOptions exact_o = opts(), fast_o = opts();
+  fast_o.ray_early_stop_voxels = 4;
+  TraversabilityMap exact(exact_o), fast(fast_o);
+  const Vector3f o(1.0f, 0.2f, 0.5f);
+  const auto pts = storey::test::scan_vlp16(w, o, 0.f, 1);
+  const InsertStats se = exact.insert_scan(o, pts), sf = fast.insert_scan(o, pts);
+  EXPECT_LT(sf.voxels_walked, se.voxels_walked / 2);
+  EXPECT_EQ(exact.occupied_voxels(), fast.occupied_voxels());
+  size_t free_exact = 0, free_fast = 0, fast_not_exact = 0;
+  const MapView ve = exact.view(), vf = fast.view();
+  ve.store().for_each([&](const VoxelBlock& b) {
+    for (int i = 0; i < kBlockCells; ++i) {
+      const VoxelKey k{(b.bx << kBlockBits) | (i >> 6), (b.by << kBlockBits) | ((i >> 3) & 7),
+                       (b.bz << kBlockBits) | (i & 7)};
+      free_exact += ve.occupancy(k) == Occupancy::kFree;
+    }
+  });
+  vf.store().for_each([&](const VoxelBlock& b) {
+    for (int i = 0; i < kBlockCells; ++i) {
+      const VoxelKey k{(b.bx << kBlockBits) | (i >> 6), (b.by << kBlockBits) | ((i >> 3) & 7),
+                       (b.bz << kBlockBits) | (i & 7)};
+      if (vf.occupancy(k) != Occupancy::kFree) continue;
+      ++free_fast;
+      fast_not_exact += ve.occupancy(k) != Occupancy::kFree;
+    }
+  });
+  EXPECT_EQ(fast_not_exact, 0u);
+  EXPECT_GE(free_fast, free_exact * 85 / 100) << free_fast << " of " << free_exact;
 }
