@@ -19,7 +19,7 @@ function(storey_module target)
   endif()
 endfunction()
 
-# storey_test_dir(<name> LIBS <libs...> [LABELS <labels...>])
+# storey_test_dir(<name> LIBS <libs...> [LABELS <label>])
 # Builds every .cpp in the calling folder into one GoogleTest executable test_<name>.
 function(storey_test_dir name)
   cmake_parse_arguments(T "" "" "LIBS;LABELS" ${ARGN})
@@ -31,8 +31,12 @@ function(storey_test_dir name)
   target_link_libraries(test_${name} PRIVATE ${T_LIBS} GTest::gtest GTest::gtest_main GTest::gmock)
   target_compile_definitions(test_${name} PRIVATE STOREY_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
                              STOREY_BINARY_DIR="${PROJECT_BINARY_DIR}")
-  set(labels unit ${T_LABELS})
-  # The list goes through a generated script: escape its separators or only "unit" survives.
-  string(REPLACE ";" "\\;" labels "${labels}")
-  gtest_discover_tests(test_${name} PROPERTIES LABELS "${labels}" DISCOVERY_TIMEOUT 60)
+  # One label per test directory: CMake 3.25's gtest_discover_tests drops all but the first
+  # element of a label list. Test names carry the directory ("rt.SpscQueue.Order").
+  set(label unit)
+  if(T_LABELS)
+    list(GET T_LABELS 0 label)
+  endif()
+  gtest_discover_tests(test_${name} TEST_PREFIX "${name}." PROPERTIES LABELS ${label}
+                       DISCOVERY_TIMEOUT 60)
 endfunction()
