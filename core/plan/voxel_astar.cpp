@@ -60,6 +60,33 @@ bool VoxelAStar::passable(const map::MapView& view, const map::VoxelKey& k, floa
   return true;
 }
 
+bool VoxelAStar::near_obstacle(const map::MapView& view, const map::VoxelKey& k,
+                               float surface_h) const {
+  const RobotModel& robot = view.robot();
+  const double s = view.voxel_size_m();
+  const double soft = opt_.soft_radius_m >= 0 ? opt_.soft_radius_m
+                                              : 0.5 * robot.body_length_m + robot.body_margin_m;
+  const double hard = opt_.inflation_radius_m >= 0 ? opt_.inflation_radius_m
+                                                   : 0.5 * robot.body_width_m + robot.body_margin_m;
+  if (soft <= hard || opt_.clearance_weight <= 0) return false;
+  const double z_lo = surface_h + robot.step_height_m;
+  const double z_hi = surface_h + robot.body_height_m + robot.body_margin_m;
+  const int32_t kz0 = int32_t(std::floor(z_lo / s)), kz1 = int32_t(std::floor(z_hi / s));
+  const Eigen::Vector2d c((k.x + 0.5) * s, (k.y + 0.5) * s);
+  for (const double r : {0.5 * (soft + hard), soft}) {
+    for (int a = 0; a < 16; ++a) {
+      const double th = a * (M_PI / 8);
+      const int32_t x = int32_t(std::floor((c.x() + r * std::cos(th)) / s));
+      const int32_t y = int32_t(std::floor((c.y() + r * std::sin(th)) / s));
+      for (int32_t z = kz0; z <= kz1; ++z) {
+        const auto zs = view.surface_height_m({x, y, z});
+        if (zs && *zs >= z_lo && *zs < z_hi) return true;
+      }
+    }
+  }
+  return false;
+}
+
 uint32_t VoxelAStar::neighbour(const map::MapView& view, int32_t x, int32_t y, float h) {
   const double s = view.voxel_size_m();
   const Eigen::Vector3f p(float((x + 0.5) * s), float((y + 0.5) * s), h);
@@ -67,10 +94,12 @@ uint32_t VoxelAStar::neighbour(const map::MapView& view, int32_t x, int32_t y, f
   if (!sp) return kNone;
   const uint64_t key = pack(sp->key);
   auto [it, fresh] = passable_.try_emplace(key, 0);
-  if (fresh) it->second = passable(view, sp->key, sp->height_m) ? 1 : 0;
+  if (fresh && passable(view, sp->key, sp->height_m))
+    it->second = kPass | (near_obstacle(view, sp->key, sp->height_m) ? kNear : 0);
   if (!it->second) return kNone;
   auto [ni, created] = index_.try_emplace(key, uint32_t(nodes_.size()));
-  if (created) nodes_.push_back({sp->key, sp->height_m, INFINITY, kNone, false});
+  if (created)
+    nodes_.push_back({sp->key, sp->height_m, bool(it->second & kNear), INFINITY, kNone, false});
   return ni->second;
 }
 
@@ -108,7 +137,7 @@ VoxelPath VoxelAStar::plan(const map::MapView& view, const Eigen::Vector3d& star
 
   // The start is where the robot stands: accepted even if its clearance test fails (it may be
   // brushing a wall); every other state must pass.
-  nodes_.push_back({s_sp->key, s_sp->height_m, 0.0, kNone, false});
+  nodes_.push_back({s_sp->key, s_sp->height_m, false, 0.0, kNone, false});
   index_.emplace(pack(s_sp->key), 0);
   passable_.emplace(pack(s_sp->key), 1);
   heap_.push_back({heuristic(point(nodes_[0])), 0});
@@ -150,7 +179,8 @@ VoxelPath VoxelAStar::plan(const map::MapView& view, const Eigen::Vector3d& star
       const Eigen::Vector3d np = point(n);
       if (std::abs(np.z() - cp.z()) > step) continue;
       goal_seen_passable |= at_goal(np);
-      const double w = (np - cp).norm() * (1.0 + opt_.cost_weight * view.cost(n.key));
+      const double w = (np - cp).norm() * (1.0 + opt_.cost_weight * view.cost(n.key) +
+                                           (n.near ? opt_.clearance_weight : 0.0));
       const double g = cur.g + w;
       if (g < n.g) {
         n.g = g;

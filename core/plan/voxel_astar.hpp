@@ -12,7 +12,8 @@
 // Moves go to the 8 horizontal neighbours' support voxel whose surface height is within
 // step_height_m of the current one (stairs); diagonals need both side neighbours passable (no
 // corner cutting). The slope limit is the map's: a voxel steeper than max_slope is not S_trav.
-// Step cost = 3D distance between surface points * (1 + cost_weight * c(v')), c(v') of Eq. 2.
+// Step cost = 3D distance between surface points * (1 + cost_weight * c(v') + clearance_weight *
+// near(v')), c(v') of Eq. 2, near(v') = an obstacle within soft_radius_m (see the options).
 #include <cstdint>
 #include <unordered_map>
 #include <vector>
@@ -31,6 +32,11 @@ struct VoxelAStarOptions {
   double goal_tolerance_m = 0.25;  // any state this close (horizontally, same level) reaches it
   double snap_window_m = 0.5;      // vertical search for the support under start / goal [m]
   double inflation_radius_m = -1;  // horizontal clearance; < 0: half body width + margin
+  // Soft clearance: a state with an obstacle within this radius (sampled on two rings, 16
+  // columns each) costs (1 + clearance_weight) more per metre, so paths keep the long body
+  // (0.8 m box) off corners where there is room; < 0: half body length + margin.
+  double soft_radius_m = -1;
+  double clearance_weight = 1.0;
 };
 
 enum class VoxelAStarStatus : uint8_t {
@@ -63,6 +69,8 @@ class VoxelAStar {
   // Whether a support voxel is a valid state (exposed for tests and for callers snapping
   // viewpoints); uses the same memo as the search only during plan().
   bool passable(const map::MapView& view, const map::VoxelKey& k, float surface_h) const;
+  // Obstacle (above step height, below the body top) within soft_radius_m of the state.
+  bool near_obstacle(const map::MapView& view, const map::VoxelKey& k, float surface_h) const;
 
   const VoxelAStarOptions& options() const { return opt_; }
 
@@ -70,6 +78,7 @@ class VoxelAStar {
   struct Node {
     map::VoxelKey key;
     float h_m;  // surface height
+    bool near;  // near_obstacle()
     double g;   // cost so far
     uint32_t parent;
     bool closed;
@@ -87,7 +96,8 @@ class VoxelAStar {
   VoxelAStarOptions opt_;
   std::vector<Node> nodes_;
   std::unordered_map<uint64_t, uint32_t> index_;    // packed key -> node
-  std::unordered_map<uint64_t, uint8_t> passable_;  // packed key -> 0/1 memo
+  std::unordered_map<uint64_t, uint8_t> passable_;  // packed key -> 0 / kPass [| kNear] memo
+  static constexpr uint8_t kPass = 1, kNear = 2;
   std::vector<HeapItem> heap_;
 };
 

@@ -1,0 +1,260 @@
+#include "core/plan/bspline_trajectory.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace storey::core::plan {
+
+namespace {
+double wrap(double a) {
+  return std::remainder(a, 2.0 * M_PI);
+}
+}  // namespace
+
+const char* to_string(TrajectoryStatus s) {
+  switch (s) {
+    case TrajectoryStatus::kOk:
+      return "ok";
+    case TrajectoryStatus::kPolyline:
+      return "ok (fell back to the pinned polyline)";
+    case TrajectoryStatus::kBadInput:
+      return "bad input (empty path or non-finite values)";
+    case TrajectoryStatus::kCollision:
+      return "collision: even the polyline hits the map";
+  }
+  return "?";
+}
+
+BsplineTrajectory::BsplineTrajectory(std::vector<Eigen::Vector3d> ctrl,
+                                     std::vector<double> yaw_ctrl, double dt_s, double t0_s)
+    : ctrl_(std::move(ctrl)), yaw_(std::move(yaw_ctrl)), dt_(dt_s), t0_(t0_s) {
+  if (yaw_.size() != ctrl_.size()) yaw_.resize(ctrl_.size(), yaw_.empty() ? 0.0 : yaw_.back());
+  if (!(dt_ > 0)) dt_ = 1.0;
+}
+
+TrajectorySample BsplineTrajectory::sample(double t) const {
+  TrajectorySample s;
+  if (empty()) return s;
+  const int n = int(ctrl_.size());
+  double ut = std::clamp((t - t0_) / dt_, 0.0, double(n - 3));
+  if (!std::isfinite(ut)) ut = 0;
+  const int i = std::min(int(ut), n - 4);
+  const double u = ut - i, u2 = u * u, u3 = u2 * u, w = 1 - u;
+  const double b[4] = {w * w * w / 6, (3 * u3 - 6 * u2 + 4) / 6, (-3 * u3 + 3 * u2 + 3 * u + 1) / 6,
+                       u3 / 6};
+  const double d[4] = {-w * w / 2, (3 * u2 - 4 * u) / 2, (-3 * u2 + 2 * u + 1) / 2, u2 / 2};
+  const double a[4] = {w, 3 * u - 2, -3 * u + 1, u};
+  double yaw_rate_u = 0;
+  for (int k = 0; k < 4; ++k) {
+    s.p_m += b[k] * ctrl_[i + k];
+    s.v_mps += d[k] * ctrl_[i + k];
+    s.a_mps2 += a[k] * ctrl_[i + k];
+    s.yaw_rad += b[k] * yaw_[i + k];
+    yaw_rate_u += d[k] * yaw_[i + k];
+  }
+  s.v_mps /= dt_;
+  s.a_mps2 /= dt_ * dt_;
+  s.yaw_rate_rps = yaw_rate_u / dt_;
+  // Pitch of the terrain along the heading: from the velocity, or the local chord at rest.
+  Eigen::Vector3d dir = s.v_mps;
+  if (dir.head<2>().norm() < 1e-3) dir = ctrl_[i + 3] - ctrl_[i];
+  const double len = dir.head<2>().norm();
+  if (len > 1e-6) {
+    const double fwd = dir.x() * std::cos(s.yaw_rad) + dir.y() * std::sin(s.yaw_rad);
+    s.pitch_rad = std::atan2(fwd >= 0 ? dir.z() : -dir.z(), len);
+  }
+  return s;
+}
+
+BodyPose BsplineTrajectory::pose(double t) const {
+  const TrajectorySample s = sample(t);
+  return BodyPose{s.p_m, s.yaw_rad, s.pitch_rad, t};
+}
+
+double BsplineTrajectory::speed_bound_mps() const {
+  double m = 0;
+  for (size_t i = 0; i + 1 < ctrl_.size(); ++i)
+    m = std::max(m, (ctrl_[i + 1] - ctrl_[i]).head<2>().norm() / dt_);
+  return m;
+}
+
+double BsplineTrajectory::accel_bound_mps2() const {
+  double m = 0;
+  for (size_t i = 0; i + 2 < ctrl_.size(); ++i)
+    m = std::max(m, (ctrl_[i + 2] - 2 * ctrl_[i + 1] + ctrl_[i]).head<2>().norm() / (dt_ * dt_));
+  return m;
+}
+
+bool TrajectoryBuilder::segment_ok(const map::MapView& view, CollisionChecker& checker,
+                                   const Eigen::Vector3d& a, const Eigen::Vector3d& b) const {
+  const double s = view.voxel_size_m();
+  const double step = robot_.step_height_m;
+  const int n = std::max(1, int(std::ceil((b - a).head<2>().norm() / (0.5 * s))));
+  for (int k = 0; k <= n; ++k) {
+    const Eigen::Vector3d p = a + (b - a) * (double(k) / n);
+    const auto sp = view.support_surface_near(p.cast<float>(), step);
+    if (!sp || sp->state != map::TravState::kTraversable) return false;
+    if (opt_.reachable_only && !sp->reachable) return false;
+  }
+  return !checker.check_segment(view, a, b, std::nan("")).collides;
+}
+
+BsplineTrajectory TrajectoryBuilder::fit(std::span<const Eigen::Vector3d> wp,
+                                         std::span<const uint8_t> pinned, double yaw_start,
+                                         std::optional<double> yaw_goal, double t0) const {
+  std::vector<Eigen::Vector3d> c;
+  const double spacing = std::max(opt_.control_spacing_m, 1e-2);
+  c.insert(c.end(), 3, wp[0]);
+  for (size_t k = 0; k + 1 < wp.size(); ++k) {
+    const Eigen::Vector3d d = wp[k + 1] - wp[k];
+    const int nseg = std::max(1, int(std::ceil(d.norm() / spacing)));
+    for (int j = 1; j < nseg; ++j) c.push_back(wp[k] + d * (double(j) / nseg));
+    c.push_back(wp[k + 1]);
+    if (pinned[k + 1] || k + 2 == wp.size()) c.insert(c.end(), 2, wp[k + 1]);
+  }
+  if (wp.size() == 1) c.insert(c.end(), 3, wp[0]);  // single point: start and end triples
+
+  // Yaw control points: start yaw on the start triple, then the travel direction through each
+  // point (next distinct minus previous distinct), the goal yaw on the end triple; unwrapped.
+  const int n = int(c.size());
+  std::vector<double> y(size_t(n), yaw_start);
+  double carry = yaw_start;
+  for (int q = 3; q < n - 3; ++q) {
+    int lo = q, hi = q;
+    while (lo > 0 && (c[lo] - c[q]).head<2>().norm() < 1e-6) --lo;
+    while (hi < n - 1 && (c[hi] - c[q]).head<2>().norm() < 1e-6) ++hi;
+    const Eigen::Vector3d d = c[hi] - c[lo];
+    if (d.head<2>().norm() > 1e-6) carry = std::atan2(d.y(), d.x());
+    y[q] = carry;
+  }
+  for (int q = std::max(3, n - 3); q < n; ++q) y[q] = yaw_goal ? *yaw_goal : carry;
+  for (int q = 1; q < n; ++q) y[q] = y[q - 1] + wrap(y[q] - y[q - 1]);
+
+  // Spread large yaw changes over several intervals (turning while moving slowly, or in place at
+  // a triple): with one knot interval for the whole curve, a single half turn between two
+  // control points would otherwise slow down every metre of it. Budget per interval: half the
+  // yaw the limits allow in the nominal interval spacing / v_max.
+  const double vmax = std::max(robot_.max_speed_mps, 1e-3);
+  const double wmax = std::max(robot_.max_yaw_rate_rps, 1e-3);
+  const double yaw_step = 0.5 * wmax * spacing / vmax;
+  std::vector<Eigen::Vector3d> c2;
+  std::vector<double> y2;
+  c2.reserve(c.size());
+  y2.reserve(c.size());
+  for (int q = 0; q < n; ++q) {
+    if (q > 0) {
+      const int k = int(std::ceil(std::abs(y[q] - y[q - 1]) / yaw_step - 1e-9));
+      for (int j = 1; j < k; ++j) {
+        const double f = double(j) / k;
+        c2.push_back(c[q - 1] + f * (c[q] - c[q - 1]));
+        y2.push_back(y[q - 1] + f * (y[q] - y[q - 1]));
+      }
+    }
+    c2.push_back(c[q]);
+    y2.push_back(y[q]);
+  }
+  c.swap(c2);
+  y.swap(y2);
+  const int nc = int(c.size());
+
+  // One knot interval satisfying every limit through the convex-hull bounds.
+  double dt = 1e-3;
+  const double amax = std::max(robot_.max_accel_mps2, 1e-3);
+  const double wamax = std::max(robot_.max_yaw_accel_rps2, 1e-3);
+  for (int q = 0; q + 1 < nc; ++q) {
+    dt = std::max(dt, (c[q + 1] - c[q]).head<2>().norm() / vmax);
+    dt = std::max(dt, std::abs(y[q + 1] - y[q]) / wmax);
+  }
+  for (int q = 0; q + 2 < nc; ++q) {
+    dt = std::max(dt, std::sqrt((c[q + 2] - 2 * c[q + 1] + c[q]).head<2>().norm() / amax));
+    dt = std::max(dt, std::sqrt(std::abs(y[q + 2] - 2 * y[q + 1] + y[q]) / wamax));
+  }
+  return BsplineTrajectory(std::move(c), std::move(y), dt * (1 + 1e-9), t0);
+}
+
+TrajectoryResult TrajectoryBuilder::build(const map::MapView& view, CollisionChecker& checker,
+                                          std::span<const Eigen::Vector3d> path, double yaw_start,
+                                          std::optional<double> yaw_goal, double t0) {
+  TrajectoryResult r;
+  if (path.empty() || !std::isfinite(yaw_start) || !std::isfinite(t0) ||
+      (yaw_goal && !std::isfinite(*yaw_goal)))
+    return r;
+  for (const auto& p : path)
+    if (!p.allFinite()) return r;
+
+  // 1. Shortcut: from each kept point, gallop (1, 2, 4, ...) then bisect to the farthest point
+  // whose segment passes, so a long straight stretch costs O(log n) segment checks.
+  std::vector<Eigen::Vector3d>& wp = r.waypoints_m;
+  wp.push_back(path[0]);
+  const size_t n = path.size();
+  size_t i = 0;
+  while (i + 1 < n) {
+    size_t good = i + 1;
+    if (opt_.shortcut) {
+      size_t stepk = 1, bad = n;
+      while (good + stepk < n) {
+        ++r.segment_checks;
+        if (!segment_ok(view, checker, path[i], path[good + stepk])) {
+          bad = good + stepk;
+          break;
+        }
+        good += stepk;
+        stepk *= 2;
+      }
+      if (bad == n && good + 1 < n) {
+        ++r.segment_checks;
+        if (segment_ok(view, checker, path[i], path[n - 1]))
+          good = n - 1;
+        else
+          bad = n - 1;
+      }
+      while (bad - good > 1) {
+        const size_t mid = good + (bad - good) / 2;
+        ++r.segment_checks;
+        if (segment_ok(view, checker, path[i], path[mid]))
+          good = mid;
+        else
+          bad = mid;
+      }
+    }
+    wp.push_back(path[good]);
+    i = good;
+  }
+
+  // 2-4. Fit, check, pin the vertex nearest to a hit, repeat; then the polyline.
+  std::vector<uint8_t> pinned(wp.size(), 0);
+  auto check = [&](const BsplineTrajectory& t) {
+    return checker.check_ahead(
+        view, [&](double s) { return t.pose(s); }, t.t_start(), t.duration(), 0.0);
+  };
+  for (int attempt = 0;; ++attempt) {
+    r.trajectory = fit(wp, pinned, yaw_start, yaw_goal, t0);
+    r.hit = check(r.trajectory);
+    if (!r.hit.collides) {
+      r.status = TrajectoryStatus::kOk;
+      return r;
+    }
+    if (attempt >= opt_.max_repairs) break;
+    const Eigen::Vector3d hp = r.trajectory.sample(r.hit.t_s).p_m;
+    size_t best = 0;
+    double best_d = std::numeric_limits<double>::infinity();
+    for (size_t k = 1; k + 1 < wp.size(); ++k) {
+      const double dd = (wp[k] - hp).norm();
+      if (!pinned[k] && dd < best_d) {
+        best_d = dd;
+        best = k;
+      }
+    }
+    if (best == 0) break;  // nothing left to pin
+    pinned[best] = 1;
+    ++r.repairs;
+  }
+  std::fill(pinned.begin(), pinned.end(), 1);
+  r.trajectory = fit(wp, pinned, yaw_start, yaw_goal, t0);
+  r.hit = check(r.trajectory);
+  r.status = r.hit.collides ? TrajectoryStatus::kCollision : TrajectoryStatus::kPolyline;
+  return r;
+}
+
+}  // namespace storey::core::plan

@@ -1,0 +1,184 @@
+#include "core/plan/bspline_trajectory.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "core/plan/voxel_astar.hpp"
+#include "tests/core_plan/voxel_world.hpp"
+
+namespace storey::core::plan {
+namespace {
+
+using storey::test::aabb;
+using storey::test::World;
+
+// Independent of FCL: no occupied voxel's surface point above the ground rule lies inside the
+// (unpadded) body box at any dense sample.
+int count_body_intrusions(const map::MapView& view, const BsplineTrajectory& t,
+                          const RobotModel& robot, double dt = 0.01) {
+  int hits = 0;
+  std::vector<Eigen::Vector3f> vox;
+  for (double s = t.t_start(); s <= t.t_end(); s += dt) {
+    const BodyPose p = t.pose(s);
+    const Eigen::Matrix3d r = (Eigen::AngleAxisd(p.yaw_rad, Eigen::Vector3d::UnitZ()) *
+                               Eigen::AngleAxisd(-p.pitch_rad, Eigen::Vector3d::UnitY()))
+                                  .toRotationMatrix();
+    vox.clear();
+    view.occupied_in_box(p.foot_m.cast<float>(), Eigen::Vector3f(0.6f, 0.6f, 0.8f), vox);
+    for (const auto& c : vox) {
+      Eigen::Vector3d q = c.cast<double>();
+      q.z() = view.surface_height_m(view.key_of(c)).value_or(c.z());
+      const Eigen::Vector3d l = r.transpose() * (q - p.foot_m);
+      if (l.z() < robot.step_height_m) continue;  // ground
+      if (std::abs(l.x()) < 0.5 * robot.body_length_m &&
+          std::abs(l.y()) < 0.5 * robot.body_width_m && l.z() < robot.body_height_m)
+        ++hits;
+    }
+  }
+  return hits;
+}
+
+void expect_limits(const BsplineTrajectory& t, const RobotModel& robot) {
+  double vmax = 0, amax = 0, wmax = 0;
+  for (double s = t.t_start(); s <= t.t_end(); s += 0.005) {
+    const TrajectorySample q = t.sample(s);
+    vmax = std::max(vmax, q.v_mps.head<2>().norm());
+    amax = std::max(amax, q.a_mps2.head<2>().norm());
+    wmax = std::max(wmax, std::abs(q.yaw_rate_rps));
+  }
+  EXPECT_LE(vmax, robot.max_speed_mps + 1e-9);
+  EXPECT_LE(amax, robot.max_accel_mps2 + 1e-9);
+  EXPECT_LE(wmax, robot.max_yaw_rate_rps + 1e-9);
+  EXPECT_LE(t.speed_bound_mps(), robot.max_speed_mps + 1e-9);
+  EXPECT_GT(vmax, 0.3 * robot.max_speed_mps);  // and not uselessly slow
+}
+
+TEST(BsplineTrajectory, LimitsAndEndpointsOnRandomPolylines) {
+  // An empty map: no support (no shortcuts) and nothing to hit; the fit alone is tested.
+  map::TraversabilityMap empty;
+  RobotModel robot;
+  CollisionChecker cc(robot, 0.1);
+  TrajectoryBuilder tb(robot);
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> step(-1.5, 1.5), yaw(-M_PI, M_PI);
+  for (int trial = 0; trial < 20; ++trial) {
+    std::vector<Eigen::Vector3d> path{{0, 0, 0}};
+    for (int k = 0; k < 2 + trial % 6; ++k)
+      path.push_back(path.back() + Eigen::Vector3d(step(rng), step(rng), 0.05 * step(rng)));
+    const double y0 = yaw(rng), y1 = yaw(rng);
+    const TrajectoryResult r = tb.build(empty.view(), cc, path, y0, y1, 10.0);
+    ASSERT_EQ(r.status, TrajectoryStatus::kOk) << to_string(r.status);
+    const BsplineTrajectory& t = r.trajectory;
+    EXPECT_DOUBLE_EQ(t.t_start(), 10.0);
+    const TrajectorySample a = t.sample(t.t_start()), b = t.sample(t.t_end());
+    EXPECT_NEAR((a.p_m - path.front()).norm(), 0, 1e-9);
+    EXPECT_NEAR((b.p_m - path.back()).norm(), 0, 1e-9);
+    EXPECT_NEAR(a.v_mps.norm(), 0, 1e-9);  // starts and ends at rest
+    EXPECT_NEAR(b.v_mps.norm(), 0, 1e-9);
+    EXPECT_NEAR(std::remainder(a.yaw_rad - y0, 2 * M_PI), 0, 1e-9);
+    EXPECT_NEAR(std::remainder(b.yaw_rad - y1, 2 * M_PI), 0, 1e-9);
+    expect_limits(t, robot);
+    // Sampling outside the time range clamps to the ends.
+    EXPECT_NEAR((t.sample(-5).p_m - path.front()).norm(), 0, 1e-9);
+    EXPECT_NEAR((t.sample(1e9).p_m - path.back()).norm(), 0, 1e-9);
+  }
+}
+
+TEST(BsplineTrajectory, BadInput) {
+  map::TraversabilityMap empty;
+  CollisionChecker cc(RobotModel{}, 0.1);
+  TrajectoryBuilder tb(RobotModel{});
+  std::vector<Eigen::Vector3d> none;
+  EXPECT_EQ(tb.build(empty.view(), cc, none, 0, std::nullopt, 0).status,
+            TrajectoryStatus::kBadInput);
+  std::vector<Eigen::Vector3d> nan_path{{0, 0, 0}, {std::nan(""), 0, 0}};
+  EXPECT_EQ(tb.build(empty.view(), cc, nan_path, 0, std::nullopt, 0).status,
+            TrajectoryStatus::kBadInput);
+  std::vector<Eigen::Vector3d> one{{1, 2, 0}};
+  const TrajectoryResult r = tb.build(empty.view(), cc, one, 0, M_PI / 2, 0);  // turn in place
+  ASSERT_EQ(r.status, TrajectoryStatus::kOk);
+  EXPECT_NEAR(r.trajectory.sample(r.trajectory.t_end()).yaw_rad, M_PI / 2, 1e-9);
+  EXPECT_NEAR((r.trajectory.sample(0.3).p_m - one[0]).norm(), 0, 1e-9);
+}
+
+World room_with_pillars() {
+  World w;
+  w.add(aabb({-4, -3, -0.2f}, {6, 3, 0}));
+  w.add(aabb({-4, -3.2f, 0}, {6, -3, 2.5f}));
+  w.add(aabb({-4, 3, 0}, {6, 3.2f, 2.5f}));
+  w.add(aabb({0.8f, -0.6f, 0}, {1.4f, 0.6f, 2.5f}));  // pillar on the straight line
+  w.add(aabb({3.0f, 0.4f, 0}, {3.4f, 3.0f, 1.0f}));   // a counter from the wall
+  return w;
+}
+
+TEST(BsplineTrajectory, AStarPathToSmoothCollisionFreeTrajectory) {
+  map::TraversabilityMap m;
+  storey::test::scan_world(
+      m, room_with_pillars(),
+      {{-2, 0, 0.5f}, {2.2f, -1.5f, 0.5f}, {4.5f, 1.5f, 0.5f}, {2, 1.5f, 0.5f}});
+  const map::MapView view = m.view();
+  RobotModel robot;
+  VoxelAStar astar;
+  const VoxelPath vp = astar.plan(view, {-2, 0, 0}, {4.5, 1.5, 0});
+  ASSERT_EQ(vp.status, VoxelAStarStatus::kOk) << to_string(vp.status);
+  CollisionChecker cc(robot, view.voxel_size_m());
+  TrajectoryBuilder tb(robot);
+  const TrajectoryResult r = tb.build(view, cc, vp.points_m, 0.0, M_PI / 2, 0.0);
+  ASSERT_TRUE(r.status == TrajectoryStatus::kOk || r.status == TrajectoryStatus::kPolyline)
+      << to_string(r.status) << " hit at t=" << r.hit.t_s << " voxel " << r.hit.voxel_m.transpose()
+      << " pose " << r.trajectory.pose(r.hit.t_s).foot_m.transpose() << " yaw "
+      << r.trajectory.pose(r.hit.t_s).yaw_rad << " waypoints " << r.waypoints_m.size();
+  EXPECT_LT(r.waypoints_m.size(), vp.points_m.size() / 3);  // shortcutting pruned the path
+  EXPECT_FALSE(cc.check_ahead(
+                     view, [&](double t) { return r.trajectory.pose(t); }, 0.0,
+                     r.trajectory.duration(), 0.01)
+                   .collides);
+  EXPECT_EQ(count_body_intrusions(view, r.trajectory, robot), 0);
+  expect_limits(r.trajectory, robot);
+  EXPECT_NEAR((r.trajectory.sample(r.trajectory.t_end()).p_m - vp.points_m.back()).norm(), 0, 1e-9);
+}
+
+TEST(BsplineTrajectory, PathThroughAnObstacleIsReported) {
+  map::TraversabilityMap m;
+  storey::test::scan_world(m, room_with_pillars(), {{-2, 0, 0.5f}, {2.5f, 0, 0.5f}});
+  RobotModel robot;
+  CollisionChecker cc(robot, 0.1);
+  TrajectoryBuilder tb(robot, TrajectoryOptions{.shortcut = false});
+  std::vector<Eigen::Vector3d> through{{-2, 0, 0}, {0, 0, 0}, {2.5, 0, 0}};
+  const TrajectoryResult r = tb.build(m.view(), cc, through, 0.0, std::nullopt, 0.0);
+  EXPECT_EQ(r.status, TrajectoryStatus::kCollision);
+  EXPECT_TRUE(r.hit.collides);
+}
+
+TEST(BsplineTrajectory, ClimbsStairsWithoutCollision) {
+  World w;
+  w.add(aabb({-3, -1.5f, -0.2f}, {1, 1.5f, 0}));
+  w.stairs(1, -0.8f, 0.8f, 0, 6, 0.15f, 0.30f);
+  w.add(aabb({2.8f, -1.5f, -0.2f}, {6, 1.5f, 0.9f}));
+  w.add(aabb({-3, -1.7f, 0}, {6, -1.5f, 3.0f}));
+  w.add(aabb({-3, 1.5f, 0}, {6, 1.7f, 3.0f}));
+  map::TraversabilityMap m;
+  storey::test::scan_world(
+      m, w, {{-1, 0, 0.5f}, {0.5f, 0, 0.5f}, {1.9f, 0, 0.95f}, {4, 0, 1.4f}, {3, 0, 1.4f}});
+  const map::MapView view = m.view();
+  RobotModel robot;
+  VoxelAStar astar(VoxelAStarOptions{.reachable_only = false});
+  const VoxelPath vp = astar.plan(view, {-1, 0, 0}, {4, 0, 0.9});
+  ASSERT_EQ(vp.status, VoxelAStarStatus::kOk) << to_string(vp.status);
+  CollisionChecker cc(robot, view.voxel_size_m());
+  TrajectoryBuilder tb(robot, TrajectoryOptions{.reachable_only = false});
+  const TrajectoryResult r = tb.build(view, cc, vp.points_m, 0.0, std::nullopt, 0.0);
+  ASSERT_TRUE(r.status == TrajectoryStatus::kOk || r.status == TrajectoryStatus::kPolyline)
+      << to_string(r.status) << " hit at t=" << r.hit.t_s << " voxel " << r.hit.voxel_m.transpose();
+  EXPECT_NEAR(r.trajectory.sample(r.trajectory.t_end()).p_m.z(), vp.points_m.back().z(), 1e-9);
+  EXPECT_EQ(count_body_intrusions(view, r.trajectory, robot), 0);
+  expect_limits(r.trajectory, robot);
+}
+
+}  // namespace
+}  // namespace storey::core::plan
