@@ -8,6 +8,7 @@
 #include <cmath>
 #include <thread>
 
+#include "drivers/go2/dds_link.hpp"
 #include "drivers/go2/framed_link.hpp"
 #include "drivers/lidar/udp_receiver.hpp"
 #include "rt/spsc_queue.hpp"
@@ -251,4 +252,57 @@ TEST(HilRunner, RefusesLinksItCannotServeAndForeignSensorAddresses) {
   EXPECT_THROW(
       sim::HilRunner(scene, sim::test::loopback_params(config::SensorType::kVlp16, 40000), bad),
       std::runtime_error);
+}
+
+// The Go2's own interface: sport state over DDS, Move requests served by the stand-in in the
+// runner (one CycloneDDS domain instance shared by both sides of this process, on lo).
+TEST(HilRunner, DdsMoveRequestsMoveTheRobot) {
+  SpscQueue<lidar::PointChunk> q(64);
+  lidar::UdpReceiver::Options ro;
+  ro.bind_address = "127.0.0.1";
+  ro.port = 0;
+  lidar::UdpReceiver rx(ro, q);
+  ASSERT_TRUE(rx.open().ok);
+  config::Parameters p = sim::test::loopback_params(config::SensorType::kVlp16, rx.bound_port());
+  p.link.transport = config::LinkTransport::kDds;
+  p.link.dds.domain_id = 47;  // apart from other tests' domains
+  p.link.dds.interface = "lo";
+  p.link.dds.allow_multicast = false;
+  p.link.dds.peers = {"127.0.0.1"};
+  sim::HilOptions ho;
+  ho.duration = 30.0;
+  sim::HilRunner runner(sim::load_scene("test_box_room"), p, ho);
+  go2::DdsLinkOptions lo;
+  lo.network = go2::dds_loopback(47);
+  lo.network.interface = "lo";
+  go2::DdsLink link(lo, mono_ns());
+  ASSERT_TRUE(link.ok()) << link.error();
+  std::atomic<bool> stop{false}, done{false};
+  std::thread t([&] {
+    runner.run(stop);
+    done = true;
+  });
+  const int64_t give_up = mono_ns() + 5'000'000'000;
+  while ((!link.has_state() || link.matched_request_readers() == 0) && mono_ns() < give_up) {
+    link.poll(mono_ns());
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ASSERT_TRUE(link.has_state()) << "no sport state over DDS";
+  const int64_t end = mono_ns() + 1'000'000'000;
+  while (mono_ns() < end) {
+    const int64_t now = mono_ns();
+    link.poll(now);
+    go2::VelocityCommand v;
+    v.stamp_ns = now;
+    v.vx = 0.5f;
+    link.send_velocity(v, now);
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  link.poll(mono_ns());
+  stop = true;
+  t.join();
+  EXPECT_GT(runner.stats().velocity_commands, 10u);
+  EXPECT_GT(runner.robot_state().position.x(), 3.2);
+  EXPECT_GT(link.latest_state().position[0], 3.2f);
 }
