@@ -14,6 +14,21 @@ struct PlanOptions {
   double floor_change_dz_m = 1.5;     // support height change that means another floor
   int hyp_discard_observations = 3;   // repeated empty observations before discarding S_hyp
   double hyp_promote_radius_m = 0.5;  // support found this close to a hypothetical column
+  // Stage 1 / global order: open-tour TSP (tsp.hpp).
+  int tsp_exact_max_n = 12;  // Held-Karp up to this many nodes, heuristic beyond
+  // Stage 2: dpsi_m through the viewpoint's own yaw psi_m instead of travel direction only.
+  bool heading_via_viewpoint_yaw = false;
+  // Stage 3: voxel A* (voxel_astar.hpp).
+  int astar_max_expansions = 200000;     // bounded search
+  bool astar_reachable_only = true;      // states in C_reach only
+  double astar_cost_weight = 1.0;        // step cost * (1 + w * c(v)), c(v) of Eq. 2
+  double astar_clearance_weight = 1.0;   // extra cost per metre near obstacles (long body)
+  double astar_goal_tolerance_m = 0.25;  // reaching this close to the viewpoint is enough
+  // Stage 3: B-spline (bspline_trajectory.hpp).
+  double traj_control_spacing_m = 0.5;  // control point spacing along the pruned path
+  int traj_max_repairs = 8;             // pinned vertices before the polyline fallback
+  // FCL look-ahead of the control task (collision_checker.hpp).
+  double lookahead_s = 1.0;  // T: check the next T seconds of the trajectory
   // Ablation switches (paper Table IV).
   bool use_prior = true;
   bool incremental_maintenance = true;
