@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 
 namespace storey::core::graph {
 
@@ -301,10 +303,17 @@ void ReachableGraph::expand(SupportQuery& q, NodeId i, std::mt19937_64& rng, Gra
       continue;
     }
     if (!direction_ok(i, cand)) continue;
-    std::optional<Support> s = q.surface_near(cand.x(), cand.y(), pi.z(), window);
-    if (!s) continue;
-    if (!s->reachable) s = q.support_dilated(cand.x(), cand.y(), s->p_m.z(), q.step());
-    if (!s) continue;
+    // Local ground: near the node's own level first (one voxel of slack around the column),
+    // else the nearest surface within the slope window (stairs, ramps).
+    std::optional<Support> s = q.support_dilated(cand.x(), cand.y(), pi.z(), q.step());
+    if (!s) {
+      s = q.surface_near(cand.x(), cand.y(), pi.z(), window);
+      if (s && !s->reachable) s = q.support_dilated(cand.x(), cand.y(), s->p_m.z(), q.step());
+    }
+    if (!s) {
+      ++st.rejects[int(Reject::kNoSupport)];
+      continue;
+    }
     j = nearest(s->p_m, clearance, q.step());
     if (j != kNoId) {
       try_connect(q, i, j, st);
@@ -412,14 +421,15 @@ GraphUpdateStats ReachableGraph::update(const map::MapView& view, const Eigen::V
   GraphUpdateStats st;
   SupportQuery q(view, opt_);
   connectivity_lost_ = false;
-  // 1. The affected subgraph: nodes in the changed regions (inflated by r_e, the reach of an
-  //    edge), nearest to the robot first.
+  // 1. The affected subgraph: nodes in the changed regions inflated by the reach of their
+  //    edges and expansion candidates, nearest to the robot first.
+  const float reach = float(opt_.neighbour_radius_factor * opt_.r_e_m);
   scratch_.clear();
   for (NodeId i = 0; i < nodes_.size(); ++i) {
     const GraphNode& n = nodes_[i];
     if (!n.alive || (n.queued & GraphNode::kQueuedRevalidate)) continue;
     bool in = false;
-    for (const Aabb& b : changed) in = in || b.inflated(float(opt_.r_e_m)).contains(n.p_m);
+    for (const Aabb& b : changed) in = in || b.inflated(reach).contains(n.p_m);
     // Promotion / demotion: C_reach can grow or shrink far from the scan (region growing).
     if (!in) {
       const bool reach = view.is_reachable(n.key);
@@ -432,18 +442,15 @@ GraphUpdateStats ReachableGraph::update(const map::MapView& view, const Eigen::V
   });
   for (NodeId i : scratch_) queue_revalidate(i);
 
-  // 2. Revalidate within the budget; nodes whose state or edges changed expand again.
+  // 2. Revalidate within the budget.
   for (int b = 0; b < opt_.max_revalidations_per_update && !reval_q_.empty(); ++b) {
     const NodeId i = reval_q_.front();
     reval_q_.pop_front();
     nodes_[i].queued &= ~GraphNode::kQueuedRevalidate;
     if (!nodes_[i].alive) continue;
-    const ElementState was = nodes_[i].state;
-    const int deg = nodes_[i].degree;
     revalidate(q, i, st);
-    if (nodes_[i].alive && (nodes_[i].state != was || nodes_[i].degree != deg ||
-                            nodes_[i].degree < 2 || nodes_[i].frontier()))
-      queue_expand(i);
+    // The map changed around it: new support may have appeared within r_e.
+    if (nodes_[i].alive && nodes_[i].degree < opt_.k_max) queue_expand(i);
   }
 
   // 3. The robot's node (created if the robot stands away from the graph).

@@ -198,7 +198,10 @@ EdgeCheck SupportQuery::check_edge(const Eigen::Vector3f& a, const Eigen::Vector
       L > 1e-6f ? Eigen::Vector2f(-d.y() / L, d.x() / L) : Eigen::Vector2f(1, 0);
   const int n = std::max(1, int(std::ceil(L * inv_vs_)));
   bool reach = true;
-  float z = a.z(), gap = 0, cost_sum = 0, len = 0;
+  // z: support height of the previous sample; z2: of the one before. A leg's stride spans two
+  // samples (0.2 m at 0.1 m voxels, less than a stair tread), so the height may change by at
+  // most one step over two samples: a vertical face's noisy voxels cannot fake a staircase.
+  float z = a.z(), z2 = a.z(), gap = 0, cost_sum = 0, len = 0;
   int supported = 0;
   Eigen::Vector3f prev = a;
   for (int k = 1; k < n; ++k) {
@@ -214,9 +217,14 @@ EdgeCheck SupportQuery::check_edge(const Eigen::Vector3f& a, const Eigen::Vector
         out.reject = Reject::kCollision;
         return out;
       }
+      if (std::abs(s->p_m.z() - z2) > step_) {
+        out.reject = Reject::kStep;
+        return out;
+      }
       reach = reach && s->reachable;
       cost_sum += s->cost;
       ++supported;
+      z2 = z;
       z = s->p_m.z();
       gap = 0;
     } else {
@@ -232,6 +240,7 @@ EdgeCheck SupportQuery::check_edge(const Eigen::Vector3f& a, const Eigen::Vector
       }
       // Unknown ground: only tentative elements may bridge it, and only briefly.
       reach = false;
+      z2 = z;
       gap += L / float(n);
       if (gap > float(opt_.max_gap_m)) {
         out.reject = Reject::kGap;
@@ -242,7 +251,7 @@ EdgeCheck SupportQuery::check_edge(const Eigen::Vector3f& a, const Eigen::Vector
     len += (cur - prev).norm();
     prev = cur;
   }
-  if (std::abs(b.z() - z) > step_) {
+  if (std::abs(b.z() - z) > step_ || (n > 1 && std::abs(b.z() - z2) > step_)) {
     out.reject = Reject::kStep;
     return out;
   }

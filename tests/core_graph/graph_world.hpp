@@ -96,12 +96,14 @@ struct Harness {
     if (getenv("STOREY_DEBUG"))
       printf(
           "observe at %.2f %.2f %.2f: nodes %zu edges %zu reach %lu | pruned %u disc %u "
-          "root %d iso %d | rejects ok %u nosup %u untrav %u col %u fall %u step %u slope %u gap "
+          "root %d iso %d reval %u exp %u | rejects ok %u nosup %u untrav %u col %u fall %u step "
+          "%u slope %u gap "
           "%u notreach %u\n",
           sensor.x(), sensor.y(), sensor.z(), graph.node_count(), graph.edge_count(),
           (unsigned long)map.reachable_voxels(), last.nodes_pruned, last.disconnected,
-          int(last.has_root), int(last.root_isolated), rejects[0], rejects[1], rejects[2],
-          rejects[3], rejects[4], rejects[5], rejects[6], rejects[7], rejects[8]);
+          int(last.has_root), int(last.root_isolated), last.revalidated, last.expanded, rejects[0],
+          rejects[1], rejects[2], rejects[3], rejects[4], rejects[5], rejects[6], rejects[7],
+          rejects[8]);
   }
   void settle(int max_cycles = 200) {
     for (int i = 0; i < max_cycles && !graph.idle(); ++i) {
