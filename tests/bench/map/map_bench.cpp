@@ -53,9 +53,11 @@ MapOptions bench_options() {
   return o;
 }
 
-void insert_storey(benchmark::State& state, bool vlp16) {
+void insert_storey(benchmark::State& state, bool vlp16, bool exact = false) {
   const ScanSet& set = scans(vlp16);
-  TraversabilityMap map(bench_options());
+  MapOptions o = bench_options();
+  if (exact) o.ray_early_stop_voxels = 0;  // every voxel of every ray, like OctoMap
+  TraversabilityMap map(o);
   size_t i = 0, points = 0;
   for (auto _ : state) {
     const auto st = map.insert_scan(set.origins[i], set.scans[i]);
@@ -89,6 +91,12 @@ void BM_map_insert_vlp16_storey(benchmark::State& s) {
 }
 void BM_map_insert_vlp16_octomap(benchmark::State& s) {
   insert_octomap(s, true);
+}
+void BM_map_insert_vlp16_exact(benchmark::State& s) {
+  insert_storey(s, true, true);
+}
+void BM_map_insert_mid360_exact(benchmark::State& s) {
+  insert_storey(s, false, true);
 }
 void BM_map_insert_mid360_storey(benchmark::State& s) {
   insert_storey(s, false);
@@ -173,6 +181,12 @@ BENCHMARK(BM_map_insert_mid360_octomap)
     ->Name("map_insert_mid360/octomap")
     ->Unit(benchmark::kMillisecond)
     ->Iterations(33);
+BENCHMARK(BM_map_insert_vlp16_exact)
+    ->Name("map_insert_vlp16/storey_exact")
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_map_insert_mid360_exact)
+    ->Name("map_insert_mid360/storey_exact")
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_map_update_vlp16_storey)
     ->Name("map_update_vlp16/storey")
     ->Unit(benchmark::kMillisecond)
