@@ -222,36 +222,60 @@ TrajectoryResult TrajectoryBuilder::build(const map::MapView& view, CollisionChe
     i = good;
   }
 
-  // 2-4. Fit, check, pin the vertex nearest to a hit, repeat; then the polyline.
-  std::vector<uint8_t> pinned(wp.size(), 0);
+  // 2-4. Fit, check, pin the vertex nearest to a hit, repeat. If the pruned polyline keeps
+  // colliding (shortcut corners hug door frames, where the long body cannot turn), do the same
+  // on the A* path itself, decimated to the control spacing (it keeps the soft clearance);
+  // finally the pinned polyline.
   auto check = [&](const BsplineTrajectory& t) {
     return checker.check_ahead(
         view, [&](double s) { return t.pose(s); }, t.t_start(), t.duration(), 0.0);
   };
-  for (int attempt = 0;; ++attempt) {
-    r.trajectory = fit(wp, pinned, yaw_start, yaw_goal, t0);
-    r.hit = check(r.trajectory);
-    if (!r.hit.collides) {
+  auto repair_loop = [&](const std::vector<Eigen::Vector3d>& w) {
+    std::vector<uint8_t> pinned(w.size(), 0);
+    for (int attempt = 0;; ++attempt) {
+      r.trajectory = fit(w, pinned, yaw_start, yaw_goal, t0);
+      r.hit = check(r.trajectory);
+      if (!r.hit.collides) return true;
+      if (attempt >= opt_.max_repairs) return false;
+      const Eigen::Vector3d hp = r.trajectory.sample(r.hit.t_s).p_m;
+      size_t best = 0;
+      double best_d = std::numeric_limits<double>::infinity();
+      for (size_t k = 1; k + 1 < w.size(); ++k) {
+        const double dd = (w[k] - hp).norm();
+        if (!pinned[k] && dd < best_d) {
+          best_d = dd;
+          best = k;
+        }
+      }
+      if (best == 0) return false;  // nothing left to pin
+      pinned[best] = 1;
+      ++r.repairs;
+    }
+  };
+  if (repair_loop(wp)) {
+    r.status = TrajectoryStatus::kOk;
+    return r;
+  }
+  if (opt_.shortcut && n > 2) {
+    std::vector<Eigen::Vector3d> dense;
+    double since = 0;
+    dense.push_back(path[0]);
+    for (size_t k = 1; k + 1 < n; ++k) {
+      since += (path[k] - path[k - 1]).norm();
+      if (since >= opt_.control_spacing_m) {
+        dense.push_back(path[k]);
+        since = 0;
+      }
+    }
+    dense.push_back(path[n - 1]);
+    if (repair_loop(dense)) {
+      r.waypoints_m = std::move(dense);
       r.status = TrajectoryStatus::kOk;
       return r;
     }
-    if (attempt >= opt_.max_repairs) break;
-    const Eigen::Vector3d hp = r.trajectory.sample(r.hit.t_s).p_m;
-    size_t best = 0;
-    double best_d = std::numeric_limits<double>::infinity();
-    for (size_t k = 1; k + 1 < wp.size(); ++k) {
-      const double dd = (wp[k] - hp).norm();
-      if (!pinned[k] && dd < best_d) {
-        best_d = dd;
-        best = k;
-      }
-    }
-    if (best == 0) break;  // nothing left to pin
-    pinned[best] = 1;
-    ++r.repairs;
   }
-  std::fill(pinned.begin(), pinned.end(), 1);
-  r.trajectory = fit(wp, pinned, yaw_start, yaw_goal, t0);
+  std::vector<uint8_t> all(wp.size(), 1);
+  r.trajectory = fit(wp, all, yaw_start, yaw_goal, t0);
   r.hit = check(r.trajectory);
   r.status = r.hit.collides ? TrajectoryStatus::kCollision : TrajectoryStatus::kPolyline;
   return r;
