@@ -218,15 +218,26 @@ TEST(HilRunner, VelocityCommandsMoveTheRobotAndSilenceStopsIt) {
   EXPECT_NEAR(link.latest_state().position[0], stopped.position[0], 1e-4f);
   EXPECT_LT(stopped.position[0], 4.5f);
 
+  // StandDown lays the robot down: velocity commands no longer move it until it stands up.
+  {
+    const int64_t now = mono_ns();
+    ASSERT_EQ(link.send_mode({now, go2::ModeRequest::stand_down}, now), go2::LinkStatus::ok);
+  }
+  run_for(0.2, false);
+  run_for(0.5, true);
+  EXPECT_EQ(link.latest_state().mode, uint8_t(go2::RobotModeId::lie_down));
+  EXPECT_NEAR(link.latest_state().position[0], stopped.position[0], 1e-4f);
+
   stop = true;
   t.join();
   const sim::HilStats& s = runner.stats();
   EXPECT_GE(s.velocity_commands, 20u);
   EXPECT_GE(s.command_timeouts, 1u);
+  EXPECT_EQ(s.mode_commands, 1u);
   EXPECT_GT(s.heartbeats, 0u);
   EXPECT_EQ(s.link_dropped, 0u);
   EXPECT_EQ(s.collisions, 0u);
-  EXPECT_NEAR(runner.robot_state().position.x(), stopped.position[0], 1e-3);
+  EXPECT_NEAR(runner.robot_state().position.x(), stopped.position[0], 1e-3);  // odometry = truth
   const auto h = link.health(mono_ns());
   EXPECT_EQ(h.decode_errors, 0u);
   EXPECT_EQ(h.crc_failures, 0u);

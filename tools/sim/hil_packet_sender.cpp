@@ -87,12 +87,13 @@ int HilPacketSender::flush() {
     msgs_[i].msg_hdr.msg_iov = &iovs_[i];
     msgs_[i].msg_hdr.msg_iovlen = 1;
   }
-  std::size_t done = 0;
+  std::size_t done = 0, sent = 0;
   while (done < pending_) {
     const int n = ::sendmmsg(fd_, msgs_.data() + done, static_cast<unsigned>(pending_ - done), 0);
     if (n > 0) {
       for (int i = 0; i < n; ++i) counters_.bytes += sizes_[done + i];
       done += static_cast<std::size_t>(n);
+      sent += static_cast<std::size_t>(n);
       counters_.sent += static_cast<uint64_t>(n);
       continue;
     }
@@ -103,7 +104,7 @@ int HilPacketSender::flush() {
     ++done;
   }
   pending_ = 0;
-  return static_cast<int>(done);
+  return static_cast<int>(sent);
 }
 
 }  // namespace storey::tools::sim
