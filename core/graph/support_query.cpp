@@ -40,15 +40,14 @@ std::optional<Support> SupportQuery::surface_near(float x, float y, float z, flo
   const int32_t z_lo = zkey(z - window) - 1, z_hi = zkey(z + window) + 1;
   std::optional<Support> best;
   float best_d = std::numeric_limits<float>::infinity();
-  const Cell* top = cell({cx, cy, z_hi + 1});
-  bool above = occupied(top), above_free = free(top);
+  bool above = occupied(cell({cx, cy, z_hi + 1}));
   for (int32_t kz = z_hi; kz >= z_lo; --kz) {  // top-down so "voxel above" is known
     const VoxelKey k{cx, cy, kz};
     const Cell* c = cell(k);
     const bool occ = occupied(c);
-    // Seen from above: the voxel over a walkable surface has been crossed by rays (observed
-    // free). A slab's underside seen from below has unknown space over it and is no support.
-    if (occ && !above && above_free) {
+    // (A slab's underside seen from below also has no occupied voxel right above it; it is
+    // rejected by the body clearance, the slab's top lies within the body height.)
+    if (occ && !above) {
       const map::VoxelStats* st = c->stats == Cell::kNoStats ? nullptr : reader_.stats(k);
       const float h = (float(kz) + 0.5f) * vs_ + (st && st->count ? st->mean[2] : 0.0f);
       const float d = std::abs(h - z);
@@ -59,7 +58,6 @@ std::optional<Support> SupportQuery::surface_near(float x, float y, float z, flo
       }
     }
     above = occ;
-    above_free = free(c);
   }
   return best;
 }

@@ -13,6 +13,7 @@
 #include <Eigen/Geometry>
 
 #include "core/graph/reachable_graph.hpp"
+#include "core/graph/topological_frontiers.hpp"
 #include "core/map/traversability_map.hpp"
 
 namespace storey::test::graph {
@@ -73,12 +74,13 @@ inline std::vector<Eigen::Vector3f> scan(const World& w, const Eigen::Vector3f& 
 struct Harness {
   core::map::TraversabilityMap map;
   core::graph::ReachableGraph graph;
+  core::graph::TopologicalFrontiers frontiers;
   std::mt19937_64 rng;
   Eigen::Vector3f foot = Eigen::Vector3f::Zero();
   core::graph::GraphUpdateStats last;
 
   explicit Harness(const core::graph::GraphOptions& o = {}, uint64_t seed = 1)
-      : graph(o), rng(seed) {}
+      : graph(o), frontiers(o), rng(seed) {}
 
   // Scan from `sensor`, robot standing with its feet at `foot_m`; then run graph cycles until
   // the graph is idle (tests want the converged graph, not the per-cycle budget).
@@ -91,6 +93,7 @@ struct Harness {
     foot = foot_m;
     const core::graph::Aabb box = core::graph::scan_bounds(sensor, pts);
     last = graph.update(map.view(), foot, std::span(&box, 1), rng);
+    frontiers.update(graph, map.view(), foot, std::span(&box, 1));
     for (int r = 0; r < int(core::graph::Reject::kCount); ++r) rejects[r] += last.rejects[r];
     settle();
     if (getenv("STOREY_DEBUG"))
@@ -106,8 +109,9 @@ struct Harness {
           rejects[8]);
   }
   void settle(int max_cycles = 200) {
-    for (int i = 0; i < max_cycles && !graph.idle(); ++i) {
+    for (int i = 0; i < max_cycles && !(graph.idle() && frontiers.idle()); ++i) {
       const auto st = graph.update(map.view(), foot, {}, rng);
+      frontiers.update(graph, map.view(), foot, {});
       for (int r = 0; r < int(core::graph::Reject::kCount); ++r) rejects[r] += st.rejects[r];
       last.nodes_pruned += st.nodes_pruned;
       last.disconnected += st.disconnected;

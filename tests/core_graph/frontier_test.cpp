@@ -1,0 +1,285 @@
+// Topological frontiers, clustering, viewpoints and export (paper Sec. III-C).
+#include <set>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "core/graph/frontier_clusters.hpp"
+#include "core/graph/graph_export.hpp"
+#include "core/graph/topological_frontiers.hpp"
+#include "core/graph/viewpoint_generator.hpp"
+#include "tests/core_graph/graph_world.hpp"
+
+using namespace storey::core::graph;
+using Eigen::Vector3f;
+using storey::test::graph::Harness;
+using storey::test::graph::World;
+
+namespace {
+
+// A 12 x 8 m room (floor top z = 0) split by a wall along x = 0 from the south wall up to
+// y = 2.5 m; the two halves meet through a 1.5 m opening in the north.
+World split_room() {
+  World w;
+  w.add({-6.2f, -4.2f, -0.3f}, {6.2f, 4.2f, 0.0f});
+  w.add({-6.2f, -4.2f, 0.0f}, {6.2f, -4.0f, 2.5f});
+  w.add({-6.2f, 4.0f, 0.0f}, {6.2f, 4.2f, 2.5f});
+  w.add({-6.2f, -4.0f, 0.0f}, {-6.0f, 4.0f, 2.5f});
+  w.add({6.0f, -4.0f, 0.0f}, {6.2f, 4.0f, 2.5f});
+  w.add({-0.1f, -4.0f, 0.0f}, {0.1f, 2.5f, 2.5f});
+  return w;
+}
+
+// Range-limited scans on both sides: the south strip and the far east / west ends stay unknown.
+void observe_split_room(Harness& h, const World& w) {
+  const Vector3f foot(-2, 0, 0);
+  h.observe(w, Vector3f(-2, 0, 0.55f), foot, 150000, 1, 3.5f);
+  h.observe(w, Vector3f(-1, 3.2f, 0.55f), foot, 150000, 2, 3.5f);
+  h.observe(w, Vector3f(1, 3.2f, 0.55f), foot, 150000, 3, 3.5f);
+  h.observe(w, Vector3f(2, 0, 0.55f), foot, 150000, 4, 3.5f);
+}
+
+std::set<NodeId> flagged(const ReachableGraph& g, bool GraphNode::*flag) {
+  std::set<NodeId> out;
+  for (NodeId i = 0; i < g.node_capacity(); ++i)
+    if (g.node(i).alive && g.node(i).*flag) out.insert(i);
+  return out;
+}
+
+}  // namespace
+
+TEST(TopologicalFrontiers, WallKeepsFrontierGroupsInSeparateClusters) {
+  const World w = split_room();
+  GraphOptions o;
+  o.cluster_capacity = 1000;  // only connectivity may split the clusters
+  Harness h(o);
+  observe_split_room(h, w);
+  const ReachableGraph& g = h.graph;
+  ASSERT_GT(g.node_count(), 40u);
+  // Both sides have frontiers, and some are closer across the wall than a Euclidean cluster
+  // radius would tolerate.
+  float closest = 1e9f;
+  int west = 0, east = 0;
+  for (NodeId a = 0; a < g.node_capacity(); ++a) {
+    if (!g.node(a).alive || !g.node(a).frontier() || g.node(a).p_m.y() > 2.0f) continue;
+    west += g.node(a).p_m.x() < 0;
+    east += g.node(a).p_m.x() > 0;
+    for (NodeId b = 0; b < g.node_capacity(); ++b)
+      if (g.node(b).alive && g.node(b).frontier() && g.node(b).p_m.y() < 2.0f &&
+          (g.node(a).p_m.x() < 0) != (g.node(b).p_m.x() < 0))
+        closest = std::min(closest, (g.node(a).p_m - g.node(b).p_m).norm());
+  }
+  ASSERT_GT(west, 0);
+  ASSERT_GT(east, 0);
+  EXPECT_LT(closest, 1.6f) << "scenario: frontiers across the wall are not close";
+  FrontierClusters fc(o);
+  const auto& clusters = fc.update(h.graph);
+  ASSERT_GE(clusters.size(), 2u);
+  for (const FrontierCluster& c : clusters) {
+    // A cluster may span both halves only through the northern opening (y > 2.5).
+    bool w_south = false, e_south = false;
+    for (NodeId n : c.nodes) {
+      const Vector3f p = g.node(n).p_m;
+      EXPECT_EQ(g.node(n).cluster, c.id);
+      EXPECT_TRUE(g.node(n).frontier());
+      w_south |= p.x() < 0 && p.y() < 1.0f;
+      e_south |= p.x() > 0 && p.y() < 1.0f;
+    }
+    if (w_south && e_south) {
+      // Then it must be connected through the north: it contains nodes beyond the wall's end.
+      bool north = false;
+      for (NodeId n : c.nodes) north |= g.node(n).p_m.y() > 2.5f;
+      EXPECT_TRUE(north) << "cluster " << c.id << " merged across the wall";
+    }
+  }
+  // Capacity.
+  GraphOptions small = o;
+  small.cluster_capacity = 3;
+  FrontierClusters fc3(small);
+  size_t members = 0;
+  for (const FrontierCluster& c : fc3.update(h.graph)) {
+    EXPECT_LE(c.nodes.size(), 3u);
+    members += c.nodes.size();
+  }
+  EXPECT_EQ(
+      members, flagged(g, &GraphNode::c_sur).size() + flagged(g, &GraphNode::c_exp).size() - [&] {
+        size_t both = 0;
+        for (NodeId i : flagged(g, &GraphNode::c_sur)) both += g.node(i).c_exp;
+        return both;
+      }());
+}
+
+TEST(TopologicalFrontiers, StableClusterIdsAcrossUpdates) {
+  const World w = split_room();
+  Harness h;
+  observe_split_room(h, w);
+  FrontierClusters fc;
+  const auto first = fc.update(h.graph);
+  const auto second = fc.update(h.graph);
+  ASSERT_EQ(first.size(), second.size());
+  for (size_t i = 0; i < first.size(); ++i) {
+    EXPECT_EQ(first[i].id, second[i].id);
+    EXPECT_EQ(first[i].nodes, second[i].nodes);
+  }
+}
+
+TEST(TopologicalFrontiers, IncrementalFlagsEqualFullEvaluation) {
+  const World w = split_room();
+  Harness h;
+  observe_split_room(h, w);
+  ReachableGraph& g = h.graph;
+  std::vector<std::pair<bool, bool>> inc;
+  for (NodeId i = 0; i < g.node_capacity(); ++i) inc.emplace_back(g.node(i).c_sur, g.node(i).c_exp);
+  TopologicalFrontiers fresh;
+  for (NodeId i = 0; i < g.node_capacity(); ++i) {
+    if (!g.node(i).alive) continue;
+    fresh.evaluate(g, h.map.view(), i);
+    EXPECT_EQ(inc[i].first, g.node(i).c_sur) << "node " << i;
+    EXPECT_EQ(inc[i].second, g.node(i).c_exp) << "node " << i;
+  }
+}
+
+TEST(TopologicalFrontiers, AblationSwitchesChangeTheFlagSets) {
+  const World w = split_room();
+  Harness h;
+  observe_split_room(h, w);
+  ReachableGraph& g = h.graph;
+  auto eval_all = [&](const GraphOptions& o) {
+    TopologicalFrontiers tf(o);
+    for (NodeId i = 0; i < g.node_capacity(); ++i)
+      if (g.node(i).alive) tf.evaluate(g, h.map.view(), i);
+  };
+  eval_all(GraphOptions{});
+  const auto sur = flagged(g, &GraphNode::c_sur), exp = flagged(g, &GraphNode::c_exp);
+  ASSERT_FALSE(sur.empty());
+  ASSERT_FALSE(exp.empty());
+  EXPECT_NE(sur, exp);
+  GraphOptions no_sur;
+  no_sur.use_c_sur = false;
+  eval_all(no_sur);
+  EXPECT_TRUE(flagged(g, &GraphNode::c_sur).empty());
+  EXPECT_EQ(flagged(g, &GraphNode::c_exp), exp);
+  GraphOptions no_exp;
+  no_exp.use_c_exp = false;
+  eval_all(no_exp);
+  EXPECT_TRUE(flagged(g, &GraphNode::c_exp).empty());
+  EXPECT_EQ(flagged(g, &GraphNode::c_sur), sur);
+  GraphOptions boundary;
+  boundary.boundary_frontiers = true;
+  eval_all(boundary);
+  const auto b = flagged(g, &GraphNode::boundary);
+  EXPECT_FALSE(b.empty());
+  EXPECT_TRUE(flagged(g, &GraphNode::c_sur).empty());
+  EXPECT_TRUE(flagged(g, &GraphNode::c_exp).empty());
+  std::set<NodeId> full = sur;
+  full.insert(exp.begin(), exp.end());
+  EXPECT_NE(b, full);
+}
+
+TEST(TopologicalFrontiers, TableTopNeverGetsANode) {
+  World w;
+  w.add({-4.2f, -4.2f, -0.3f}, {4.2f, 4.2f, 0.0f});
+  w.add({-4.2f, -4.2f, 0.0f}, {4.2f, -4.0f, 2.5f});
+  w.add({-4.2f, 4.0f, 0.0f}, {4.2f, 4.2f, 2.5f});
+  w.add({-4.2f, -4.0f, 0.0f}, {-4.0f, 4.0f, 2.5f});
+  w.add({4.0f, -4.0f, 0.0f}, {4.2f, 4.0f, 2.5f});
+  // Table: a 1.6 x 1.0 m top at 0.72-0.76 m on four legs.
+  w.add({-0.8f, -0.5f, 0.72f}, {0.8f, 0.5f, 0.76f});
+  for (float x : {-0.75f, 0.7f})
+    for (float y : {-0.45f, 0.4f}) w.add({x, y, 0.0f}, {x + 0.05f, y + 0.05f, 0.72f});
+  Harness h;
+  const Vector3f foot(-2.5f, 0, 0);
+  h.observe(w, Vector3f(-2.5f, 0, 0.55f), foot, 150000, 1, 6.0f);
+  h.observe(w, Vector3f(2.5f, 0, 0.55f), foot, 150000, 2, 6.0f);
+  // Views from above (e.g. from a landing) make the table top a well-observed flat surface.
+  h.observe(w, Vector3f(0, -2, 1.8f), foot, 150000, 3, 6.0f);
+  h.observe(w, Vector3f(0, 2, 1.8f), foot, 150000, 4, 6.0f);
+  const auto top = h.map.view().support_surface_near(Vector3f(0, 0, 0.76f), 0.1);
+  ASSERT_TRUE(top.has_value()) << "scenario: the table top is not mapped";
+  EXPECT_FALSE(top->reachable);
+  ASSERT_GT(h.graph.node_count(), 20u);
+  for (NodeId i = 0; i < h.graph.node_capacity(); ++i)
+    if (h.graph.node(i).alive)
+      EXPECT_LT(h.graph.node(i).p_m.z(), 0.3f)
+          << "node on the table at " << h.graph.node(i).p_m.transpose();
+}
+
+TEST(ViewpointGenerator, FieldOfViewOfVlp16AndMid360) {
+  storey::core::map::TraversabilityMap empty;  // all unknown: nothing occludes
+  GraphOptions o;
+  SupportQuery q(empty.view(), o);
+  ViewpointGenerator vlp(o, SensorFov::vlp16()), mid(o, SensorFov::mid360());
+  const Vector3f origin(0, 0, 0.5f);
+  const Vector3f low(1.5f, 0, 0.15f);  // -13 deg: VLP-16 only
+  const Vector3f high(1.0f, 0, 1.5f);  // +45 deg: Mid-360 only
+  const Vector3f far(40.0f, 0, 0.5f);  // beyond range
+  EXPECT_TRUE(vlp.visible(q, origin, 0, low));
+  EXPECT_FALSE(mid.visible(q, origin, 0, low));
+  EXPECT_FALSE(vlp.visible(q, origin, 0, high));
+  EXPECT_TRUE(mid.visible(q, origin, 0, high));
+  EXPECT_FALSE(vlp.visible(q, origin, 0, far));
+  SensorFov narrow = SensorFov::vlp16();
+  narrow.h_fov_deg = 90;
+  ViewpointGenerator front(o, narrow);
+  EXPECT_TRUE(front.visible(q, origin, 0, Vector3f(3, 0.5f, 0.5f)));
+  EXPECT_FALSE(front.visible(q, origin, float(M_PI), Vector3f(3, 0.5f, 0.5f)));
+}
+
+TEST(ViewpointGenerator, BestKFacingTheClusterAndOccludedByWalls) {
+  const World w = split_room();
+  GraphOptions o;
+  o.viewpoints_per_cluster = 4;
+  Harness h(o);
+  observe_split_room(h, w);
+  FrontierClusters fc(o);
+  const auto& clusters = fc.update(h.graph);
+  ASSERT_FALSE(clusters.empty());
+  ViewpointGenerator vg(o, SensorFov::vlp16());
+  const auto& vps = vg.update(h.graph, h.map.view(), clusters);
+  ASSERT_EQ(vps.size(), clusters.size());
+  int with_viewpoints = 0;
+  for (size_t c = 0; c < clusters.size(); ++c) {
+    EXPECT_EQ(vps[c].cluster_id, clusters[c].id);
+    EXPECT_LE(vps[c].viewpoints.size(), 4u);
+    with_viewpoints += !vps[c].viewpoints.empty();
+    for (size_t k = 0; k < vps[c].viewpoints.size(); ++k) {
+      const Viewpoint& v = vps[c].viewpoints[k];
+      EXPECT_GT(v.visible, 0);
+      EXPECT_LE(v.visible, int(clusters[c].nodes.size()));
+      if (k) EXPECT_LE(v.visible, vps[c].viewpoints[k - 1].visible);
+      const Vector3f d = clusters[c].centroid_m - v.p_m;
+      if (std::hypot(d.x(), d.y()) > 0.05f) {
+        EXPECT_NEAR(std::remainder(v.yaw_rad - std::atan2(d.y(), d.x()), 2 * M_PI), 0, 1e-4);
+      }
+    }
+  }
+  EXPECT_GT(with_viewpoints, 0);
+  // The wall occludes: a sensor just east of it does not see a point just west of it.
+  SupportQuery q(h.map.view(), o);
+  EXPECT_FALSE(
+      vg.visible(q, Vector3f(0.6f, -2.0f, 0.5f), float(M_PI), Vector3f(-0.6f, -2.0f, 0.15f)));
+  EXPECT_TRUE(vg.visible(q, Vector3f(-2.6f, -2.0f, 0.5f), 0, Vector3f(-0.6f, -2.0f, 0.15f)));
+}
+
+TEST(GraphExport, JsonAndPlyDescribeTheGraph) {
+  const World w = split_room();
+  Harness h;
+  observe_split_room(h, w);
+  FrontierClusters fc;
+  const auto& clusters = fc.update(h.graph);
+  const std::string json = to_json(h.graph, &clusters);
+  size_t states = 0;
+  for (size_t p = json.find("\"state\""); p != std::string::npos; p = json.find("\"state\"", p + 1))
+    ++states;
+  EXPECT_EQ(states, h.graph.node_count() + h.graph.edge_count());
+  EXPECT_NE(json.find("\"clusters\": ["), std::string::npos);
+  EXPECT_NE(json.find("\"c_sur\": true"), std::string::npos);
+  const std::string ply = to_ply(h.graph);
+  EXPECT_NE(ply.find("element vertex " + std::to_string(h.graph.node_count()) + "\n"),
+            std::string::npos);
+  EXPECT_NE(ply.find("element edge " + std::to_string(h.graph.edge_count()) + "\n"),
+            std::string::npos);
+  std::string err;
+  EXPECT_FALSE(write_text_file("/nonexistent-dir/g.ply", ply, &err));
+  EXPECT_NE(err.find("/nonexistent-dir/g.ply"), std::string::npos);
+}
