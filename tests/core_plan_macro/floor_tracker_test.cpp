@@ -1,0 +1,88 @@
+#include "core/plan/floor_tracker.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+using namespace storey::core::plan;
+
+namespace {
+// Robot climbing 17 steps of 0.17 m (one step per 0.5 s), starting at t0.
+double stairs_z(double t, double t0) {
+  const int steps = std::clamp(int((t - t0) / 0.5), 0, 17);
+  return 0.17 * steps;
+}
+}  // namespace
+
+TEST(FloorTracker, DetectsTheNextFloorAfterTheStairsOnceStable) {
+  FloorTracker ft;
+  EXPECT_TRUE(ft.update(0.0, 0.0));
+  EXPECT_EQ(ft.current(), 0);
+  bool changed = false;
+  double changed_at = -1;
+  for (double t = 0.1; t < 20.0; t += 0.1) {
+    const bool c = ft.update(stairs_z(t, 1.0), t);
+    if (c && !changed) changed_at = t;
+    changed = changed || c;
+  }
+  ASSERT_TRUE(changed);
+  EXPECT_EQ(ft.current(), 1);
+  EXPECT_TRUE(ft.is_new_floor());
+  EXPECT_EQ(ft.floors().size(), 2u);
+  // On the landing (z = 2.89 from t = 9.5) for stable_s = 2 s, not during the climb.
+  EXPECT_GE(changed_at, 9.5 + 2.0 - 1e-9);
+  EXPECT_LT(changed_at, 9.5 + 2.0 + 0.5);
+  EXPECT_NEAR(ft.floor(1).z_m, 2.89, 1e-9);
+}
+
+TEST(FloorTracker, HeightsOnTheStairsNeverMakeAFloorAndGoingBackFindsTheOldOne) {
+  FloorTracker ft;
+  ft.update(0.0, 0.0);
+  // Up and down a long slow ramp: never stable beyond the band.
+  double t = 0;
+  for (; t < 30; t += 0.1) ft.update(0.1 * t, t);  // 0 .. 3 m, 0.1 m/s
+  for (int i = 0; i < 40; ++i, t += 0.1) ft.update(3.0, t);
+  ASSERT_EQ(ft.current(), 1);
+  for (int i = 0; i < 40; ++i, t += 0.1) ft.update(0.05, t);
+  EXPECT_EQ(ft.current(), 0);
+  EXPECT_FALSE(ft.is_new_floor());
+  EXPECT_EQ(ft.floors().size(), 2u);
+}
+
+TEST(FloorTracker, NodeLabelsDzFromModesAndReferenceFloor) {
+  FloorTracker ft;
+  ft.update(0.02, 0.0);
+  for (int i = 0; i < 30; ++i) ft.update(3.1, 1.0 + 0.1 * i);
+  ASSERT_EQ(ft.current(), 1);
+  std::vector<float> z;
+  for (int i = 0; i < 50; ++i) z.push_back(0.0f + 0.01f * float(i % 3));  // floor 0 at ~0.01
+  for (int i = 0; i < 50; ++i) z.push_back(3.0f + 0.01f * float(i % 3));  // floor 1 at ~3.01
+  for (int i = 0; i < 10; ++i) z.push_back(0.17f * float(5 + i));         // stairs 0.85..2.38
+  ft.refine(z);
+  EXPECT_NEAR(ft.floor(0).z_m, 0.01, 0.005);
+  EXPECT_NEAR(ft.floor(1).z_m, 3.01, 0.005);
+  EXPECT_NEAR(ft.dz(0, 1), 3.0, 0.01);
+  EXPECT_EQ(ft.floor_of(0.1), 0);
+  EXPECT_EQ(ft.floor_of(1.5), -1);  // stairs
+  EXPECT_EQ(ft.floor_of(2.9), 1);
+  EXPECT_EQ(ft.choose_reference(1), 0);
+  EXPECT_EQ(ft.choose_reference(0), 1);
+  // A third floor above: floor 1 (adjacent) is the reference, never floor 0.
+  for (int i = 0; i < 30; ++i) ft.update(6.0, 5.0 + 0.1 * i);
+  ASSERT_EQ(ft.current(), 2);
+  ft.floor(0).explored = true;
+  EXPECT_EQ(ft.choose_reference(2), 1);
+  // Between two adjacent floors the explored one wins.
+  ft.floor(0).explored = false;
+  ft.floor(2).explored = true;
+  EXPECT_EQ(ft.choose_reference(1), 2);
+}
+
+TEST(FloorTracker, NonFiniteInputIsCountedAndIgnored) {
+  FloorTracker ft;
+  EXPECT_FALSE(ft.update(std::nan(""), 0.0));
+  EXPECT_EQ(ft.bad_input(), 1u);
+  EXPECT_EQ(ft.current(), -1);
+}
