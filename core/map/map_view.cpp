@@ -28,43 +28,43 @@ Eigen::Vector3f MapView::centre_of(const VoxelKey& k) const {
 }
 
 Occupancy MapView::occupancy(const VoxelKey& k) const {
-  BlockReader r(*store_);
+  BlockReader& r = reader();
   return occupancy_of(r.cell(k), occ_threshold(*opt_));
 }
 
 bool MapView::is_support(const VoxelKey& k) const {
-  BlockReader r(*store_);
+  BlockReader& r = reader();
   const int16_t occ = occ_threshold(*opt_);
   if (occupancy_of(r.cell(k), occ) != Occupancy::kOccupied) return false;
   return occupancy_of(r.cell({k.x, k.y, k.z + 1}), occ) != Occupancy::kOccupied;
 }
 
 TravState MapView::state(const VoxelKey& k) const {
-  BlockReader r(*store_);
+  BlockReader& r = reader();
   const Cell* c = r.cell(k);
   return c ? c->state : TravState::kNone;
 }
 
 bool MapView::is_reachable(const VoxelKey& k) const {
-  BlockReader r(*store_);
+  BlockReader& r = reader();
   const Cell* c = r.cell(k);
   return c && (c->flags & Cell::kReachable);
 }
 
 uint32_t MapView::point_count(const VoxelKey& k) const {
-  BlockReader r(*store_);
+  BlockReader& r = reader();
   const VoxelStats* s = r.stats(k);
   return s ? s->count : 0;
 }
 
 float MapView::cost(const VoxelKey& k) const {
-  BlockReader r(*store_);
+  BlockReader& r = reader();
   const VoxelStats* s = r.stats(k);
   return s ? s->cost : 0.0f;
 }
 
 std::optional<float> MapView::surface_height_m(const VoxelKey& k) const {
-  BlockReader r(*store_);
+  BlockReader& r = reader();
   if (occupancy_of(r.cell(k), occ_threshold(*opt_)) != Occupancy::kOccupied) return std::nullopt;
   const VoxelStats* s = r.stats(k);
   const float centre = float((k.z + 0.5) * opt_->voxel_size_m);
@@ -73,7 +73,7 @@ std::optional<float> MapView::surface_height_m(const VoxelKey& k) const {
 
 std::optional<SurfacePoint> MapView::support_surface_near(const Eigen::Vector3f& p,
                                                           double window_m) const {
-  BlockReader r(*store_);
+  BlockReader& r = reader();
   const int16_t occ = occ_threshold(*opt_);
   const double s = opt_->voxel_size_m;
   const VoxelKey c = key_of(p);
@@ -102,7 +102,7 @@ std::optional<SurfacePoint> MapView::support_surface_near(const Eigen::Vector3f&
 
 Occupancy MapView::probe(const Eigen::Vector3f& from, const Eigen::Vector3f& to,
                          VoxelKey* hit) const {
-  BlockReader r(*store_);
+  BlockReader& r = reader();
   const int16_t occ = occ_threshold(*opt_);
   const double inv = 1.0 / opt_->voxel_size_m;
   const VoxelKey start = key_of(from);
@@ -132,7 +132,7 @@ Occupancy MapView::probe(const Eigen::Vector3f& from, const Eigen::Vector3f& to,
 
 std::optional<VoxelKey> MapView::first_occupied(const Eigen::Vector3f& from,
                                                 const Eigen::Vector3f& to) const {
-  BlockReader r(*store_);
+  BlockReader& r = reader();
   const int16_t occ = occ_threshold(*opt_);
   const double inv = 1.0 / opt_->voxel_size_m;
   const VoxelKey start = key_of(from);
@@ -161,7 +161,7 @@ bool MapView::is_segment_free(const Eigen::Vector3f& from, const Eigen::Vector3f
 }
 
 bool MapView::is_free_above(const VoxelKey& k, double height_m, bool unknown_is_free) const {
-  BlockReader r(*store_);
+  BlockReader& r = reader();
   const int16_t occ = occ_threshold(*opt_);
   const int n = int(std::ceil(height_m / opt_->voxel_size_m - 1e-6));
   for (int i = 1; i <= n; ++i) {
@@ -174,7 +174,7 @@ bool MapView::is_free_above(const VoxelKey& k, double height_m, bool unknown_is_
 
 size_t MapView::occupied_in_box(const Eigen::Vector3f& centre, const Eigen::Vector3f& half,
                                 std::vector<Eigen::Vector3f>& out) const {
-  BlockReader r(*store_);
+  BlockReader& r = reader();
   const int16_t occ = occ_threshold(*opt_);
   const VoxelKey lo = key_of(centre - half), hi = key_of(centre + half);
   const size_t before = out.size();

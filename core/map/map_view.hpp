@@ -1,8 +1,9 @@
 #pragma once
 // Read-only queries on the traversability map (paper Sec. III-A), used by the reachable graph,
-// frontiers, viewpoints, A* and the FCL look-ahead. A MapView is a pair of references: over a
-// MapSnapshot it is valid as long as the snapshot lives (any thread); over the live map it is
-// valid only on the owner thread and only until the next mutating call on the map.
+// frontiers, viewpoints, A* and the FCL look-ahead. A MapView is references plus a block cache:
+// over a MapSnapshot it is valid as long as the snapshot lives; over the live map it is valid
+// only on the owner thread and only until the next mutating call on the map. The cache makes a
+// view single-threaded: make one view per thread (construction is free).
 #include <cmath>
 #include <cstdint>
 #include <optional>
@@ -73,7 +74,7 @@ struct SurfacePoint {
 class MapView {
  public:
   MapView(const BlockStore& store, const MapOptions& options, const RobotModel& robot)
-      : store_(&store), opt_(&options), robot_(&robot) {}
+      : store_(&store), opt_(&options), robot_(&robot), cache_(store) {}
 
   double voxel_size_m() const { return opt_->voxel_size_m; }
   VoxelKey key_of(const Eigen::Vector3f& p_m) const;
@@ -143,6 +144,20 @@ class MapView {
   const BlockStore* store_;
   const MapOptions* opt_;
   const RobotModel* robot_;
+  // Consecutive queries mostly touch the same blocks (A* expansions, probes): keep them.
+  // Invalidation: dropped whenever the store cloned (copy-on-write) or created a block since
+  // the last query, so even a live-map view kept past a mutating call never dereferences a
+  // replaced block (its answers are then merely as of that call).
+  BlockReader& reader() const {
+    const uint64_t gen = store_->cow_copies() + store_->block_count();
+    if (gen != cache_gen_) {
+      cache_.invalidate();
+      cache_gen_ = gen;
+    }
+    return cache_;
+  }
+  mutable BlockReader cache_;
+  mutable uint64_t cache_gen_ = ~uint64_t{0};
 };
 
 }  // namespace storey::core::map
