@@ -29,6 +29,16 @@ struct PlanOptions {
   int traj_max_repairs = 8;             // pinned vertices before the polyline fallback
   // FCL look-ahead of the control task (collision_checker.hpp).
   double lookahead_s = 1.0;  // T: check the next T seconds of the trajectory
+  // Macro layer (Sec. IV-A..C; exploration_planner.hpp).
+  double floor_stable_s = 2.0;           // new support height must hold this long (floor change)
+  double floor_node_band_m = 0.6;        // nodes within this of a floor's height belong to it
+  double zone_clearance_radius_m = 3.0;  // bounded obstacle search for zone seeds (IV-A)
+  double hyp_height_window_m = 0.5;      // |z - projected z| for promotion / merge (dz error)
+  double hyp_check_radius_m = 20.0;      // hypotheses re-checked within this of the robot
+  double hyp_bridge_radius_m = 1.6;      // hypothetical links from real nodes to S_hyp nodes
+  int zone_merge_cross_edges = 2;        // "sufficient cross-zone edges" for a merge (IV-B 3)
+  double zone_merge_distance_m = 3.0;    // ... or centroids this close
+  double zone_visit_radius_m = 1.5;      // robot this close to c_k: zone visited (state C test)
   // Ablation switches (paper Table IV).
   bool use_prior = true;
   bool incremental_maintenance = true;
