@@ -10,6 +10,10 @@ std::span<const Command> commands() {
        cmd_replay},
       {"self-check", "quick check of this build: clocks, scheduler, queues, default config",
        cmd_self_check},
+#ifdef STOREY_HAVE_SIM
+      {"sim", "lockstep simulated exploration of a scene (the main job), writes a run record",
+       cmd_sim},
+#endif
   };
   return kCommands;
 }

@@ -1,0 +1,337 @@
+#include "core/plan/local_planner.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <map>
+
+#include "core/plan/plan_config.hpp"
+
+namespace storey::core::plan {
+
+const char* to_string(LocalPlanStatus s) {
+  switch (s) {
+    case LocalPlanStatus::kNewTrajectory:
+      return "new_trajectory";
+    case LocalPlanStatus::kKeep:
+      return "keep";
+    case LocalPlanStatus::kNoFrontiers:
+      return "no_frontiers";
+    case LocalPlanStatus::kNoReachableTarget:
+      return "no_reachable_target";
+    case LocalPlanStatus::kNoRobotNode:
+      return "no_robot_node";
+    case LocalPlanStatus::kBadInput:
+      return "bad_input";
+  }
+  return "unknown";
+}
+
+LocalPlanner::LocalPlanner(const RobotModel& robot, const PlanOptions& plan, double voxel_size_m,
+                           const LocalPlannerOptions& options)
+    : robot_(robot),
+      plan_opt_(plan),
+      opt_(options),
+      tsp_(tsp_options(plan)),
+      dp_(dp_options(plan)),
+      astar_(astar_options(plan)),
+      builder_(robot, trajectory_options(plan)),
+      checker_(robot, voxel_size_m) {}
+
+bool LocalPlanner::ignored(const Eigen::Vector3f& p) const {
+  const float r2 = float(opt_.set_aside_radius_m * opt_.set_aside_radius_m);
+  for (const Eigen::Vector3f& q : set_aside_)
+    if ((p.head<2>() - q.head<2>()).squaredNorm() <= r2 && std::abs(p.z() - q.z()) < 0.5f)
+      return true;
+  return false;
+}
+
+const graph::FrontierCluster* LocalPlanner::find_cluster(const LocalPlanInput& in,
+                                                         int32_t id) const {
+  for (const auto& c : *in.clusters)
+    if (c.id == id) return &c;
+  return nullptr;
+}
+
+void LocalPlanner::build_search_graph(const graph::ReachableGraph& g) {
+  pos_scratch_.assign(g.node_capacity(), Eigen::Vector3d::Zero());
+  for (size_t i = 0; i < g.node_capacity(); ++i)
+    if (g.node(graph::NodeId(i)).alive)
+      pos_scratch_[i] = g.node(graph::NodeId(i)).p_m.cast<double>();
+  edges_scratch_.clear();
+  for (size_t e = 0; e < g.edge_capacity(); ++e) {
+    const graph::GraphEdge& ge = g.edge(graph::EdgeId(e));
+    if (!ge.alive) continue;
+    // Real elements only (confirmed and tentative are both G_real); hypothetical ones are the
+    // macro layer's business.
+    if (ge.state == graph::ElementState::kHypothetical) continue;
+    edges_scratch_.push_back({ge.a, ge.b, double(std::max(ge.cost, ge.length_m))});
+  }
+  sg_ = SearchGraph::from_edges(pos_scratch_, edges_scratch_, /*undirected=*/true);
+}
+
+bool LocalPlanner::try_target(const LocalPlanInput& in, const Viewpoint& vp, LocalPlanResult& out) {
+  ++out.astar_calls;
+  VoxelPath path = astar_.plan(*in.view, in.robot_foot_m, vp.p_m);
+  // The ground under the feet may be in the LiDAR's blind ring (start-up): search from the
+  // nearest confirmed graph nodes instead, the closest observed support the robot stands by.
+  for (size_t k = 0; path.status == VoxelAStarStatus::kNoStartSupport && k < start_nodes_m_.size();
+       ++k) {
+    path = astar_.plan(*in.view, start_nodes_m_[k], vp.p_m);
+    if (path.status == VoxelAStarStatus::kOk)
+      path.points_m.insert(path.points_m.begin(), in.robot_foot_m);
+  }
+  if (getenv("STOREY_DEBUG"))
+    fprintf(stderr, "astar to %.2f %.2f %.2f from %.2f %.2f %.2f: %s n=%zu\n", vp.p_m.x(),
+            vp.p_m.y(), vp.p_m.z(), in.robot_foot_m.x(), in.robot_foot_m.y(), in.robot_foot_m.z(),
+            to_string(path.status), path.points_m.size());
+  if (path.status != VoxelAStarStatus::kOk && vp.node < sg_.num_nodes() &&
+      robot_node_ < sg_.num_nodes()) {
+    // Fallback: the path along G_real. Its edges were checked over the support surface by the
+    // graph (tentative ones may bridge short under-observed gaps, max_gap_m): what a sparse
+    // standstill VLP-16 map (rings of ground 0.3-0.4 m apart) still supports. The B-spline
+    // below is checked against the body with FCL like any other path.
+    const PathResult gp = pair_search_.astar(sg_, robot_node_, vp.node);
+    if (gp.found) {
+      path.points_m.clear();
+      path.points_m.push_back(in.robot_foot_m);
+      for (uint32_t u : gp.nodes) path.points_m.push_back(sg_.position(u));
+      if (path.points_m.size() == 2) path.points_m.push_back(vp.p_m);
+      path.status = VoxelAStarStatus::kOk;
+      ++out.graph_fallbacks;
+    }
+  }
+  if (path.status != VoxelAStarStatus::kOk || path.points_m.empty()) return false;
+  // The path starts at the robot's support voxel; start the curve at the robot itself.
+  path.points_m.front() = in.robot_foot_m;
+  TrajectoryResult tr =
+      builder_.build(*in.view, checker_, path.points_m, in.robot_yaw_rad, vp.yaw_rad, in.t_s);
+  if (getenv("STOREY_DEBUG")) fprintf(stderr, "traj %s\n", to_string(tr.status));
+  if (tr.status != TrajectoryStatus::kOk && tr.status != TrajectoryStatus::kPolyline) return false;
+  out.trajectory = std::move(tr.trajectory);
+  out.path_m = std::move(path.points_m);
+  out.target_m = vp.p_m;
+  out.target_yaw_rad = vp.yaw_rad;
+  out.real_until_s = out.trajectory.t_end();  // the local layer plans on G_real only
+  return true;
+}
+
+LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
+  LocalPlanResult out;
+  if (!in.view || !in.graph || !in.clusters || !in.viewpoints || !in.robot_foot_m.allFinite()) {
+    out.status = LocalPlanStatus::kBadInput;
+    return out;
+  }
+  const graph::ReachableGraph& g = *in.graph;
+  out.clusters_total = int(in.clusters->size());
+
+  // ---- Keep the current target unless there is a reason to replan.
+  const char* reason = "no target";
+  if (has_target_) {
+    const graph::FrontierCluster* tc = find_cluster(in, target_cluster_);
+    const double dxy = (in.robot_foot_m - target_m_).head<2>().norm();
+    const bool reached =
+        dxy <= opt_.reached_radius_m && std::abs(in.robot_foot_m.z() - target_m_.z()) < 0.5;
+    if (reached || in.t_s > current_.t_end() + 3.0) {
+      // Stood at the viewpoint (or should have long ago): whatever of the cluster is still a
+      // frontier cannot be resolved from here.
+      if (tc)
+        for (graph::NodeId n : tc->nodes) set_aside_.push_back(g.node(n).p_m);
+      reason = reached ? "target reached" : "target overdue";
+      has_target_ = false;
+    } else if (!tc) {
+      reason = "target cluster observed";
+      has_target_ = false;
+    } else {
+      bool all_ignored = true;
+      for (graph::NodeId n : tc->nodes) all_ignored = all_ignored && ignored(g.node(n).p_m);
+      const double t_from = std::clamp(in.t_s, current_.t_start(), current_.t_end());
+      const CollisionHit hit = checker_.check_ahead(
+          *in.view, [&](double t) { return current_.pose(t); }, t_from,
+          std::max(0.0, current_.t_end() - t_from), 0.0);
+      if (all_ignored) {
+        reason = "target set aside";
+        has_target_ = false;
+      } else if (hit.collides) {
+        reason = "trajectory collides on the new map";
+        has_target_ = false;
+      } else if (in.t_s - planned_at_s_ >= opt_.replan_period_s) {
+        reason = "periodic replan";
+        has_target_ = false;
+      } else {
+        out.status = LocalPlanStatus::kKeep;
+        out.target_cluster = target_cluster_;
+        out.target_m = target_m_;
+        out.real_until_s = current_.t_end();
+        return out;
+      }
+    }
+  }
+  out.replan_reason = reason;
+
+  // ---- Stage 1: TSP over the cluster representatives (graph path costs).
+  if (in.clusters->empty()) {
+    out.status = LocalPlanStatus::kNoFrontiers;
+    return out;
+  }
+  build_search_graph(g);
+  uint32_t robot_node = g.root();
+  if (robot_node == graph::kNoId || !g.node(robot_node).alive)
+    robot_node = g.nearest(in.robot_foot_m.cast<float>(), 1.5f, 1.0f);
+  if (robot_node == graph::kNoId) {
+    out.status = LocalPlanStatus::kNoRobotNode;
+    return out;
+  }
+  robot_node_ = robot_node;
+  {
+    std::vector<graph::NodeId> near;
+    g.nodes_within(in.robot_foot_m.cast<float>(), 3.0f, 1.0f, near);
+    std::vector<std::pair<float, graph::NodeId>> by_d;
+    for (graph::NodeId n : near)
+      if (g.node(n).alive && g.node(n).state == graph::ElementState::kConfirmed)
+        by_d.push_back({(g.node(n).p_m - in.robot_foot_m.cast<float>()).squaredNorm(), n});
+    std::sort(by_d.begin(), by_d.end());
+    start_nodes_m_.clear();
+    for (size_t k = 0; k < by_d.size() && k < 3; ++k)
+      start_nodes_m_.push_back(g.node(by_d[k].second).p_m.cast<double>());
+  }
+  search_.dijkstra(sg_, std::span<const uint32_t>(&robot_node, 1));
+  std::vector<Candidate> cands;
+  std::vector<double> cand_dist;
+  for (size_t ci = 0; ci < in.clusters->size(); ++ci) {
+    const graph::FrontierCluster& c = (*in.clusters)[ci];
+    uint32_t rep = graph::kNoId;
+    float best = std::numeric_limits<float>::infinity();
+    bool any = false;
+    for (graph::NodeId n : c.nodes) {
+      if (ignored(g.node(n).p_m)) continue;
+      any = true;
+      const float d = (g.node(n).p_m - c.centroid_m).squaredNorm();
+      if (d < best) best = d, rep = n;
+    }
+    if (!any) {
+      ++out.clusters_set_aside;
+      continue;
+    }
+    const double d = search_.dist(rep);
+    if (!std::isfinite(d)) {
+      ++out.clusters_unreachable;
+      continue;
+    }
+    cands.push_back({c.id, ci, rep});
+    cand_dist.push_back(d);
+  }
+  if (cands.empty()) {
+    out.status = LocalPlanStatus::kNoReachableTarget;
+    return out;
+  }
+  // The nearest clusters (by graph distance) enter the TSP; the rest wait for later cycles.
+  std::vector<size_t> idx(cands.size());
+  for (size_t i = 0; i < idx.size(); ++i) idx[i] = i;
+  std::stable_sort(idx.begin(), idx.end(),
+                   [&](size_t a, size_t b) { return cand_dist[a] < cand_dist[b]; });
+  if (int(idx.size()) > opt_.max_tsp_clusters) idx.resize(size_t(opt_.max_tsp_clusters));
+  std::vector<Candidate> sel;
+  for (size_t i : idx) sel.push_back(cands[i]);
+
+  const bool with_anchor = in.anchor_m.has_value();
+  uint32_t anchor_node = graph::kNoId;
+  if (with_anchor) anchor_node = g.nearest(in.anchor_m->cast<float>(), 3.0f, 1.5f);
+  const int n = int(sel.size()) + 1 + (anchor_node != graph::kNoId ? 1 : 0);
+  std::vector<uint32_t> nodes_of(static_cast<size_t>(n), 0u);
+  nodes_of[0] = robot_node;
+  for (size_t i = 0; i < sel.size(); ++i) nodes_of[i + 1] = sel[i].rep;
+  if (anchor_node != graph::kNoId) nodes_of[size_t(n - 1)] = anchor_node;
+  std::vector<double> cost(size_t(n) * size_t(n), 0.0);
+  for (int i = 0; i < n; ++i)
+    search_.costs_from(sg_, nodes_of[size_t(i)], nodes_of,
+                       std::span<double>(cost.data() + size_t(i) * size_t(n), size_t(n)));
+  const TspResult tour =
+      tsp_.solve(CostMatrix{n, cost}, 0, anchor_node != graph::kNoId ? n - 1 : -1);
+  std::vector<size_t> order;  // indices into sel
+  if (tour.status == TspStatus::kOk) {
+    for (int k : tour.order)
+      if (k > 0 && k <= int(sel.size())) order.push_back(size_t(k - 1));
+  } else {
+    for (size_t i = 0; i < sel.size(); ++i) order.push_back(i);  // by distance
+  }
+  for (size_t k : order) out.cluster_order.push_back(sel[k].cluster_id);
+
+  // ---- Stage 2: one viewpoint per cluster over the window W (Eq. 6).
+  auto viewpoints_of = [&](const Candidate& c) {
+    std::vector<Viewpoint> v;
+    for (const auto& cv : *in.viewpoints) {
+      if (cv.cluster_id != c.cluster_id) continue;
+      for (const auto& gv : cv.viewpoints) {
+        if (int(v.size()) >= plan_opt_.max_candidates_k) break;
+        if (gv.node >= g.node_capacity() || !g.node(gv.node).alive) continue;
+        v.push_back({gv.p_m.cast<double>(), double(gv.yaw_rad), gv.node});
+      }
+    }
+    if (v.empty()) {  // no scored viewpoint: stand on the representative, facing the centroid
+      const auto& cl = (*in.clusters)[c.cluster_index];
+      const Eigen::Vector3f p = g.node(c.rep).p_m;
+      const Eigen::Vector3f d = cl.centroid_m - p;
+      const double yaw = d.head<2>().norm() > 1e-3f ? std::atan2(d.y(), d.x()) : in.robot_yaw_rad;
+      v.push_back({p.cast<double>(), yaw, c.rep});
+    }
+    return v;
+  };
+  const size_t w = std::min(order.size(), size_t(std::max(1, plan_opt_.window_w)));
+  std::vector<std::vector<Viewpoint>> window;
+  for (size_t m = 0; m < w; ++m) window.push_back(viewpoints_of(sel[order[m]]));
+  std::map<std::pair<uint32_t, uint32_t>, double> memo;
+  const ViewpointDistance d = [&](const Viewpoint& a, const Viewpoint& b) {
+    if (a.node == b.node) return (a.p_m - b.p_m).norm();
+    if (a.node >= sg_.num_nodes() || b.node >= sg_.num_nodes()) return (a.p_m - b.p_m).norm() * 1.5;
+    const auto key = std::make_pair(std::min(a.node, b.node), std::max(a.node, b.node));
+    auto it = memo.find(key);
+    if (it != memo.end()) return it->second;
+    const PathResult r = pair_search_.astar(sg_, a.node, b.node);
+    const double c = r.found ? r.cost : kUnreachable;
+    memo.emplace(key, c);
+    return c;
+  };
+  const Viewpoint x0{in.robot_foot_m, in.robot_yaw_rad, robot_node};
+  std::optional<Viewpoint> anchor;
+  if (anchor_node != graph::kNoId) anchor = Viewpoint{in.anchor_m.value(), 0.0, anchor_node};
+  const DpResult dp = dp_.solve(x0, window, anchor, d);
+
+  // ---- Stage 3: voxel A* + B-spline to the first viewpoint; on failure the cluster's other
+  // candidates, then the next clusters (bounded).
+  int attempts = 0;
+  for (size_t m = 0; m < order.size() && attempts < opt_.max_stage3_attempts; ++m) {
+    const Candidate& c = sel[order[m]];
+    std::vector<Viewpoint> vps = m < window.size() ? window[m] : viewpoints_of(c);
+    if (m == 0 && dp.status == DpStatus::kOk && !dp.choice.empty())
+      std::rotate(vps.begin(), vps.begin() + dp.choice[0], vps.begin() + dp.choice[0] + 1);
+    bool ok = false;
+    for (size_t k = 0; k < vps.size() && attempts < opt_.max_stage3_attempts && !ok;
+         ++k, ++attempts)
+      ok = try_target(in, vps[k], out);
+    if (ok) {
+      has_target_ = true;
+      target_cluster_ = c.cluster_id;
+      target_m_ = out.target_m;
+      current_ = out.trajectory;
+      planned_at_s_ = in.t_s;
+      out.target_cluster = c.cluster_id;
+      out.status = LocalPlanStatus::kNewTrajectory;
+      return out;
+    }
+    // Stage 3 failed for this cluster: after max_failures cycles it is set aside.
+    auto it = std::find_if(failures_.begin(), failures_.end(),
+                           [&](const auto& f) { return f.first == c.cluster_id; });
+    if (it == failures_.end()) it = failures_.insert(failures_.end(), {c.cluster_id, 0});
+    if (++it->second >= opt_.max_failures) {
+      for (graph::NodeId nd : (*in.clusters)[c.cluster_index].nodes)
+        set_aside_.push_back(g.node(nd).p_m);
+      failures_.erase(it);
+    }
+  }
+  out.status = LocalPlanStatus::kNoReachableTarget;
+  return out;
+}
+
+}  // namespace storey::core::plan

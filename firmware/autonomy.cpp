@@ -1,0 +1,409 @@
+#include "firmware/autonomy.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+
+namespace storey::firmware {
+
+const char* to_string(ExplorationState s) {
+  switch (s) {
+    case ExplorationState::kStarting:
+      return "starting";
+    case ExplorationState::kExploring:
+      return "exploring";
+    case ExplorationState::kComplete:
+      return "complete";
+  }
+  return "unknown";
+}
+
+namespace {
+constexpr const char* kTaskNames[] = {"ingest", "map", "plan", "control", "watchdog", "telemetry"};
+
+// The LiDAR cannot see the ground within h / tan(-v_min) of the robot (VLP-16 at 0.5 m: 1.9 m),
+// so at start-up there is no observed support under the feet. The reachable-set seed search and
+// the graph's root search (which probes at half its radius) must reach past that blind ring.
+AutonomyOptions widen_for_blind_zone(AutonomyOptions o) {
+  const double down = -o.fov.v_min_deg * M_PI / 180.0;
+  if (down <= 0.01) return o;
+  const double blind = o.fov.mount_height_m / std::tan(down) + 0.5;
+  o.params.map.seed_search_radius_m = std::max(o.params.map.seed_search_radius_m, blind);
+  o.params.graph.root_radius_m = std::max(o.params.graph.root_radius_m, 2.0 * blind);
+  return o;
+}
+
+core::plan::BodyPose pose_on(const core::plan::BsplineTrajectory& t, double tau) {
+  return t.pose(std::clamp(tau, t.t_start(), t.t_end()));
+}
+}  // namespace
+
+Autonomy::Autonomy(Platform& platform, const rt::Clock& clock, AutonomyOptions options)
+    : platform_(platform),
+      clock_(clock),
+      opt_(widen_for_blind_zone(std::move(options))),
+      trace_(opt_.trace_events),
+      pool_(opt_.scan_pool),
+      filled_q_(opt_.scan_pool),
+      free_q_(opt_.scan_pool),
+      map_(opt_.params.map, opt_.params.robot),
+      graph_(opt_.params.graph),
+      frontiers_(opt_.params.graph),
+      clusters_(opt_.params.graph),
+      viewpoints_(opt_.params.graph, opt_.fov),
+      rng_(opt_.seed),
+      planner_(opt_.params.robot, opt_.params.plan, opt_.params.map.voxel_size_m),
+      law_(opt_.params.robot),
+      safety_(opt_.params.safety),
+      lookahead_(opt_.params.robot, opt_.params.map.voxel_size_m),
+      stop_q_(256) {
+  for (ScanBuffer& b : pool_) {
+    b.points_m.reserve(opt_.scan_reserve_points);
+    free_q_.try_push(&b);
+  }
+  drop_buf_.points_m.reserve(opt_.scan_reserve_points);
+  rt::SchedulerOptions so;
+  so.trace = &trace_;
+  so.lockstep_event_hz = opt_.lockstep_event_hz;
+  so.use_priorities = opt_.params.realtime.sched_fifo;
+  so.pin_cpus = opt_.params.realtime.cpu_pinning;
+  so.lock_memory = opt_.params.realtime.mlockall;
+  const std::vector<rt::TaskSpec> table = task_table();
+  sched_ = std::make_unique<rt::Scheduler>(table, so);
+}
+
+Autonomy::~Autonomy() {
+  if (sched_ && sched_->running()) sched_->stop();
+}
+
+// ---------------------------------------------------------------------------------------------
+// THE task table (ArduPilot style): every periodic activity of the firmware, in one place.
+// Rates, budgets, priorities and CPUs come from the configuration's `rates` section.
+// Order matters in lockstep (ties run in table order): ingest delivers before the map consumes,
+// the map publishes before the planner reads, the planner before the control task tracks.
+std::vector<rt::TaskSpec> Autonomy::task_table() {
+  const config::RateTable& r = opt_.params.rates;
+  auto row = [](const char* name, const config::TaskRate& tr, std::function<void()> fn) {
+    return rt::TaskSpec{name, tr.rate_hz, tr.budget_us, tr.priority, tr.cpu, std::move(fn), -1};
+  };
+  return {
+      //  name         rate/budget/prio/cpu   body
+      row(kTaskNames[kIngest], r.ingest, [this] { ingest_step(); }),        // event-driven (polled)
+      row(kTaskNames[kMap], r.map, [this] { map_step(); }),                 // 10 Hz
+      row(kTaskNames[kPlan], r.plan, [this] { plan_step(); }),              // 2 Hz
+      row(kTaskNames[kControl], r.control, [this] { control_step(); }),     // 50 Hz
+      row(kTaskNames[kWatchdog], r.watchdog, [this] { watchdog_step(); }),  // 10 Hz
+      row(kTaskNames[kTelemetry], r.telemetry, [this] { telemetry_step(); }),  // 1 Hz
+  };
+}
+
+bool Autonomy::suspend_task(const char* name, bool on) {
+  for (int i = 0; i < kTaskCount; ++i)
+    if (std::strcmp(name, kTaskNames[i]) == 0) {
+      suspended_[i].store(on, std::memory_order_release);
+      return true;
+    }
+  return false;
+}
+
+ExplorationStatus Autonomy::status() const {
+  ExplorationStatus s;
+  status_mb_.read(s);
+  return s;
+}
+
+VelocityCommand Autonomy::last_command() const {
+  VelocityCommand c;
+  cmd_mb_.read(c);
+  return c;
+}
+
+void Autonomy::log(const std::string& line) const {
+  if (opt_.log)
+    opt_.log(line);
+  else
+    std::fprintf(stderr, "storey: %s\n", line.c_str());
+}
+
+// ---- ingest (event-driven): the platform's next sweep into a pool buffer, queued to the map.
+void Autonomy::ingest_step() {
+  if (suspended(kIngest)) return;
+  for (;;) {
+    if (!ingest_buf_ && !free_q_.try_pop(ingest_buf_)) ingest_buf_ = nullptr;
+    ScanBuffer& dst = ingest_buf_ ? *ingest_buf_ : drop_buf_;
+    if (!platform_.take_scan(dst)) return;
+    scan_stamp_mb_.write(dst.stamp_s);
+    if (!ingest_buf_) {  // the map task is behind: every buffer is in flight
+      scans_dropped_.fetch_add(1, std::memory_order_relaxed);
+      continue;
+    }
+    filled_q_.try_push(ingest_buf_);  // cannot fail: the pool has as many buffers as slots
+    ingest_buf_ = nullptr;
+  }
+}
+
+// ---- map + graph (10 Hz): insert scans, traversability, C_reach, G_real, frontiers, clusters,
+// viewpoints; publish the world model.
+void Autonomy::map_step() {
+  if (suspended(kMap)) return;
+  if (getenv("STOREY_DEBUG"))
+    fprintf(stderr, "map_step t=%.2f filled %zu\n", now_s(), filled_q_.size_approx());
+  ScanBuffer* b = nullptr;
+  while (filled_q_.try_pop(b)) {
+    map_.insert_scan(b->origin_m, b->points_m);
+    changed_.push_back(core::graph::scan_bounds(b->origin_m, b->points_m));
+    ++scans_inserted_;
+    free_q_.try_push(b);
+  }
+  PoseSample pose;
+  if (pose_mb_.read(pose) == 0) return;  // no odometry yet: C_reach needs the robot's foot
+  const Eigen::Vector3f foot = pose.position().cast<float>();
+  map_.update_traversability();
+  const auto rs = map_.update_reachable(foot);
+  const core::map::MapView view = map_.view();
+  // Until G_real has a node near the robot, anchor it at the latest C_reach seed: the ground
+  // under the feet is in the LiDAR's blind ring, the seed is the nearest observed support.
+  Eigen::Vector3f anchor = foot;
+  if (graph_.node_count() == 0 && !map_.reach_roots().empty()) {
+    const core::map::VoxelKey k = map_.reach_roots().back();
+    anchor = view.centre_of(k);
+    if (const auto h = view.surface_height_m(k)) anchor.z() = *h;
+  }
+  const auto gs = graph_.update(view, anchor, changed_, rng_);
+  if (getenv("STOREY_DEBUG"))
+    fprintf(stderr,
+            "map t=%.2f foot %.2f %.2f %.2f seed %d reach %lu trav %lu occ %lu nodes %zu root %d "
+            "rej %u %u %u %u %u %u\n",
+            now_s(), foot.x(), foot.y(), foot.z(), rs.has_seed,
+            (unsigned long)map_.reachable_voxels(), (unsigned long)map_.traversable_voxels(),
+            (unsigned long)map_.occupied_voxels(), graph_.node_count(), gs.has_root, gs.rejects[0],
+            gs.rejects[1], gs.rejects[2], gs.rejects[3], gs.rejects[4], gs.rejects[5]);
+  const core::graph::FrontierUpdateStats fs = frontiers_.update(graph_, view, foot, changed_);
+  const auto& clusters = clusters_.update(graph_);
+  const auto& vps = viewpoints_.update(graph_, view, clusters);
+  changed_.clear();
+
+  // Publication allocates (an immutable copy is the price of lock-free readers); the old
+  // versions are released by the telemetry task (Snapshot::collect), not here.
+  auto w = std::make_shared<WorldModel>();
+  w->cycle = ++map_cycle_;
+  w->stamp_s = now_s();
+  w->map = map_.snapshot();
+  w->graph = graph_;
+  w->clusters = clusters;
+  w->viewpoints = vps;
+  w->settled = graph_.idle() && frontiers_.idle();
+  w->frontier_nodes = fs.frontiers;
+  w->scans = scans_inserted_;
+  world_.publish(std::shared_ptr<const WorldModel>(std::move(w)));
+}
+
+// ---- plan (2 Hz): local layer (Stage 1-3) on the latest world model.
+void Autonomy::plan_step() {
+  if (suspended(kPlan)) return;
+  const double now = now_s();
+  plan_alive_mb_.write(now);  // the planner vouches for its latest trajectory
+  const auto wv = world_.read();
+  PoseSample pose;
+  if (!wv.ptr || pose_mb_.read(pose) == 0) return;
+  const WorldModel& w = *wv.ptr;
+  ++plan_cycles_;
+  if (replan_request_.exchange(false, std::memory_order_acq_rel)) planner_.drop_target();
+
+  const core::map::MapView view = w.map->view();
+  core::plan::LocalPlanInput in;
+  in.view = &view;
+  in.graph = &w.graph;
+  in.clusters = &w.clusters;
+  in.viewpoints = &w.viewpoints;
+  in.robot_foot_m = pose.position();
+  in.robot_yaw_rad = pose.yaw_rad;
+  in.t_s = now;
+  core::plan::LocalPlanResult r = planner_.plan(in);
+
+  using core::plan::LocalPlanStatus;
+  auto publish = [&](std::shared_ptr<PlannedTrajectory> p) {
+    p->id = ++traj_id_;
+    p->stamp_s = now;
+    traj_.publish(std::shared_ptr<const PlannedTrajectory>(std::move(p)));
+  };
+  if (r.status == LocalPlanStatus::kNewTrajectory) {
+    auto p = std::make_shared<PlannedTrajectory>();
+    p->trajectory = std::move(r.trajectory);
+    p->real_until_s = r.real_until_s;
+    p->target_cluster = r.target_cluster;
+    p->target_m = r.target_m;
+    p->path_m = std::move(r.path_m);
+    publish(std::move(p));
+    ++trajectories_;
+    idle_since_s_ = -1;
+  } else if (r.status == LocalPlanStatus::kNoFrontiers ||
+             r.status == LocalPlanStatus::kNoReachableTarget) {
+    const auto cur = traj_.read();
+    if (cur.ptr && !cur.ptr->trajectory.empty()) publish(std::make_shared<PlannedTrajectory>());
+    if (idle_since_s_ < 0) idle_since_s_ = now;
+    // Complete: nothing reachable left to look at, and the graph has no work carried over
+    // that could still produce a frontier.
+    // For kNoReachableTarget every cluster must be set aside or unreachable (not merely
+    // failed once in this cycle).
+    const bool exhausted = r.status == LocalPlanStatus::kNoFrontiers ||
+                           r.clusters_set_aside + r.clusters_unreachable >= r.clusters_total;
+    if (!exhausted) idle_since_s_ = now;
+    if (w.settled && w.graph.node_count() > 0 && now - idle_since_s_ >= opt_.complete_after_s)
+      complete_ = true;
+  } else if (r.status != LocalPlanStatus::kKeep) {
+    idle_since_s_ = -1;
+  }
+  if (r.status == LocalPlanStatus::kKeep || r.status == LocalPlanStatus::kNewTrajectory) {
+    idle_since_s_ = -1;
+    complete_ = false;
+  }
+
+  ExplorationStatus s;
+  s.stamp_s = now;
+  s.state = complete_ ? ExplorationState::kComplete : ExplorationState::kExploring;
+  s.last_plan = r.status;
+  s.nodes = uint32_t(w.graph.node_count());
+  s.edges = uint32_t(w.graph.edge_count());
+  s.frontier_nodes = w.frontier_nodes;
+  s.clusters = uint32_t(w.clusters.size());
+  s.clusters_set_aside = uint32_t(r.clusters_set_aside);
+  s.clusters_unreachable = uint32_t(r.clusters_unreachable);
+  s.trajectories = trajectories_;
+  s.plan_cycles = plan_cycles_;
+  s.floor_hint = int(std::lround(pose.z_m / opt_.params.graph.floor_height_hint_m));
+  status_mb_.write(s);
+}
+
+// ---- control (50 Hz): odometry in, tracking, FCL look-ahead, safety, command out.
+void Autonomy::control_step() {
+  if (suspended(kControl)) return;
+  const double now = now_s();
+  const double dt = 1.0 / opt_.params.rates.control.rate_hz;
+  PoseSample pose;
+  if (platform_.latest_pose(pose)) {
+    // A pose that did not advance is not fresh: pose_stale uses the sample's own stamp.
+    last_pose_ = pose;
+    pose_mb_.write(pose);
+  }
+  const LinkHealth link = platform_.link();
+
+  // Trajectory: a new one starts at the point nearest the robot within its first seconds (the
+  // robot kept moving while it was planned).
+  const auto tv = traj_.read();
+  if (tv.version != ctl_traj_version_) {
+    ctl_traj_version_ = tv.version;
+    ctl_traj_ = tv.ptr;
+    if (ctl_traj_ && !ctl_traj_->trajectory.empty()) {
+      const auto& t = ctl_traj_->trajectory;
+      double best = std::numeric_limits<double>::infinity();
+      tau_ = t.t_start();
+      for (double s = t.t_start(); s <= std::min(t.t_end(), t.t_start() + 2.0); s += 0.05) {
+        const double d = (t.sample(s).p_m - last_pose_.position()).head<2>().norm();
+        if (d < best) best = d, tau_ = s;
+      }
+    }
+  }
+  const bool has_traj = ctl_traj_ && !ctl_traj_->trajectory.empty();
+  const double tau_end =
+      has_traj ? std::min(ctl_traj_->trajectory.t_end(), ctl_traj_->real_until_s) : 0;
+  core::plan::TrajectorySample ref;
+  double err = 0;
+  if (has_traj) {
+    ref = ctl_traj_->trajectory.sample(std::min(tau_, tau_end));
+    if (tau_ >= tau_end) ref.v_mps.setZero(), ref.yaw_rate_rps = 0;  // hold the end pose
+    err = (ref.p_m - last_pose_.position()).head<2>().norm();
+  }
+  const bool following = has_traj && (tau_ < tau_end || err > 0.15);
+
+  // FCL look-ahead over the next lookahead_s of the trajectory, on the latest map: re-checked
+  // whenever the map or the trajectory changes (between changes the answer can only shift
+  // along the curve; the extra 0.2 s covers the 10 Hz map period).
+  const auto wv = world_.read();
+  if (has_traj && wv.ptr &&
+      (wv.version != ctl_checked_map_ || ctl_traj_version_ != ctl_checked_traj_)) {
+    ctl_checked_map_ = wv.version;
+    ctl_checked_traj_ = ctl_traj_version_;
+    const auto& t = ctl_traj_->trajectory;
+    const double horizon =
+        std::max(0.0, std::min(opt_.params.safety.lookahead_s + 0.2, tau_end - tau_));
+    const core::map::MapView view = wv.ptr->map->view();
+    const core::plan::CollisionHit hit = lookahead_.check_ahead(
+        view, [&](double s) { return pose_on(t, s); }, tau_, horizon, 0.0);
+    if (hit.collides && !collision_predicted_)
+      replan_request_.store(true, std::memory_order_release);
+    collision_predicted_ = hit.collides;
+  } else if (!has_traj) {
+    collision_predicted_ = false;
+  }
+
+  SafetyInputs in;
+  in.now_s = now;
+  double scan_s = -1, vouched_s = -1;
+  if (scan_stamp_mb_.read(scan_s) == 0) scan_s = -1;
+  if (plan_alive_mb_.read(vouched_s) == 0) vouched_s = -1;
+  in.last_scan_s = scan_s;
+  in.pose_stamp_s = last_pose_.stamp_s;
+  in.following = following;
+  in.trajectory_vouched_s =
+      has_traj || vouched_s < 0 ? vouched_s : now;  // idle: nothing to vouch for
+  in.link_connected = link.connected;
+  in.link_last_state_s = link.last_state_s;
+  in.collision_predicted = collision_predicted_;
+  in.operator_stop = operator_stop_.load(std::memory_order_acquire);
+  in.overruns = overrun_flag_.load(std::memory_order_acquire);
+  const SafetyDecision d = safety_.evaluate(in);
+  for (int r = 0; r < int(StopReason::kCount); ++r) {
+    if (d.raised & (1u << r)) {
+      reason_events_[r].fetch_add(1, std::memory_order_release);
+      stop_q_.try_push(StopEvent{now, StopReason(r), true});
+    }
+    if (d.cleared & (1u << r)) stop_q_.try_push(StopEvent{now, StopReason(r), false});
+  }
+  if (d.new_stop) safety_stops_.fetch_add(1, std::memory_order_release);
+  stop_mask_.store(d.mask, std::memory_order_release);
+
+  VelocityCommand cmd;
+  if (!d.stop && following) {
+    cmd = law_.track(ref, last_pose_, prev_cmd_, dt);
+    // Progress along the curve only while tracking well: after a stop or a lag the reference
+    // waits for the robot instead of running away from it.
+    const double yaw_err = std::abs(wrap_angle(ref.yaw_rad - last_pose_.yaw_rad));
+    const double rate =
+        std::clamp((0.6 - err) / 0.3, 0.0, 1.0) * std::clamp((1.2 - yaw_err) / 0.6, 0.0, 1.0);
+    tau_ = std::min(tau_ + dt * rate, tau_end);
+  }
+  // else: zero command (a stop is commanded in this very period; the robot's own deceleration
+  // limits bring it to rest).
+  cmd.stamp_s = now;
+  platform_.send_command(cmd);
+  cmd_mb_.write(cmd);
+  prev_cmd_ = cmd;
+}
+
+// ---- watchdog (10 Hz): control-task budget overruns within the last window.
+void Autonomy::watchdog_step() {
+  if (suspended(kWatchdog)) return;
+  const uint64_t ov = sched_->stats(kControl).overruns.load(std::memory_order_relaxed);
+  const uint64_t recent = ov - wd_overruns_;
+  wd_overruns_ = ov;
+  const bool flag = opt_.stop_on_overruns && int64_t(recent) > opt_.params.safety.max_overruns;
+  overrun_flag_.store(flag, std::memory_order_release);
+}
+
+// ---- telemetry (1 Hz, non-RT): the stop log, release of old snapshots.
+void Autonomy::telemetry_step() {
+  if (suspended(kTelemetry)) return;
+  StopEvent e;
+  char line[160];
+  while (stop_q_.try_pop(e)) {
+    std::snprintf(line, sizeof line, "t=%.2f s: safety stop %s: %s", e.t_s,
+                  e.raised ? "raised" : "cleared", to_string(e.reason));
+    log(line);
+  }
+  world_.collect();
+  traj_.collect();
+}
+
+}  // namespace storey::firmware

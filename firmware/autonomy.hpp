@@ -1,0 +1,208 @@
+#pragma once
+// The exploration stack as one task table (DESIGN §2-3): ingest, map + graph, plan, control,
+// watchdog, telemetry, wired to a Platform (robot + sensors). Independent of the simulator: the
+// `sim` verb drives it in lockstep (run_until with a VirtualClock, the simulator stepped between
+// slices), `storey run` will start() it in real time against the live platform.
+//
+// Data between tasks, only through rt/ primitives (one writer each):
+//   ingest  -> map      scans: pool of ScanBuffer + SpscQueue (filled), SpscQueue (free) back
+//   ingest  -> control  last scan stamp: Mailbox<double>
+//   control -> map/plan pose: Mailbox<PoseSample>
+//   map     -> plan     world model (map snapshot, graph copy, clusters, viewpoints): Snapshot
+//   plan    -> control  trajectory: Snapshot; planner heartbeat: Mailbox<double>
+//   control -> *        command: Mailbox<VelocityCommand>; stop events: SpscQueue -> telemetry
+//   watchdog-> control  overrun flag: atomic
+//   plan    -> *        exploration status: Mailbox<ExplorationStatus>
+// The map task is the only owner of the world model; everybody else reads immutable snapshots.
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "config/parameters.hpp"
+#include "core/graph/frontier_clusters.hpp"
+#include "core/graph/reachable_graph.hpp"
+#include "core/graph/topological_frontiers.hpp"
+#include "core/graph/viewpoint_generator.hpp"
+#include "core/map/traversability_map.hpp"
+#include "core/plan/collision_checker.hpp"
+#include "core/plan/local_planner.hpp"
+#include "firmware/control_law.hpp"
+#include "firmware/platform.hpp"
+#include "firmware/safety_monitor.hpp"
+#include "rt/mailbox.hpp"
+#include "rt/scheduler.hpp"
+#include "rt/snapshot.hpp"
+#include "rt/spsc_queue.hpp"
+#include "rt/trace.hpp"
+
+namespace storey::firmware {
+
+// What the map task publishes each cycle (immutable once published).
+struct WorldModel {
+  uint64_t cycle = 0;
+  double stamp_s = 0;
+  std::shared_ptr<const core::map::MapSnapshot> map;
+  core::graph::ReachableGraph graph;
+  std::vector<core::graph::FrontierCluster> clusters;
+  std::vector<core::graph::ClusterViewpoints> viewpoints;
+  bool settled = false;  // graph and frontier work queues empty (nothing carried over)
+  uint32_t frontier_nodes = 0;
+  uint64_t scans = 0;  // scans inserted so far
+};
+
+// What the plan task publishes: the trajectory to track (empty = hold still).
+struct PlannedTrajectory {
+  uint64_t id = 0;
+  double stamp_s = 0;
+  core::plan::BsplineTrajectory trajectory;
+  double real_until_s = 0;  // follow only up to here (real prefix toward hypotheses, Sec. IV-C)
+  int32_t target_cluster = -1;
+  Eigen::Vector3d target_m = Eigen::Vector3d::Zero();
+  std::vector<Eigen::Vector3d> path_m;
+};
+
+enum class ExplorationState : uint8_t { kStarting = 0, kExploring, kComplete };
+
+// Plain status (Mailbox): for progress lines, the run record, and ending the run.
+struct ExplorationStatus {
+  double stamp_s = 0;
+  ExplorationState state = ExplorationState::kStarting;
+  core::plan::LocalPlanStatus last_plan = core::plan::LocalPlanStatus::kNoRobotNode;
+  uint32_t nodes = 0, edges = 0, frontier_nodes = 0, clusters = 0;
+  uint32_t clusters_set_aside = 0, clusters_unreachable = 0;
+  uint64_t trajectories = 0, plan_cycles = 0;
+  int floor_hint = 0;  // round(robot z / floor_height_hint_m)
+};
+const char* to_string(ExplorationState s);
+
+struct StopEvent {
+  double t_s = 0;
+  StopReason reason = StopReason::kCount;
+  bool raised = true;  // false: cleared
+};
+
+struct AutonomyOptions {
+  config::Parameters params;
+  uint64_t seed = 1;           // graph expansion sampling (Eq. 4)
+  core::graph::SensorFov fov;  // for viewpoint visibility
+  // Budget overruns stop the robot (DESIGN §3). Off in lockstep: there the virtual clock does
+  // not wait for a slow task, and wall-time overruns would make the run non-deterministic.
+  bool stop_on_overruns = true;
+  double complete_after_s = 3.0;  // no target for this long with a settled graph = complete
+  size_t scan_pool = 4;           // scan buffers in flight (ingest -> map)
+  size_t scan_reserve_points = 65536;
+  size_t trace_events = 1 << 16;
+  double lockstep_event_hz = 100;               // how often the ingest row is polled in lockstep
+  std::function<void(const std::string&)> log;  // non-RT log sink (telemetry task); default stderr
+};
+
+class Autonomy {
+ public:
+  Autonomy(Platform& platform, const rt::Clock& clock, AutonomyOptions options);
+  ~Autonomy();
+  Autonomy(const Autonomy&) = delete;
+  Autonomy& operator=(const Autonomy&) = delete;
+
+  // Lockstep: runs every release in [clock.now_ns(), t_ns), ending with the clock at t_ns.
+  void run_until(rt::VirtualClock& clock, std::int64_t t_ns) { sched_->run_until(clock, t_ns); }
+  rt::Scheduler& scheduler() { return *sched_; }
+  const rt::TraceRing& trace() const { return trace_; }
+
+  // Any thread.
+  void set_operator_stop(bool on) { operator_stop_.store(on, std::memory_order_release); }
+  // Fault injection (tests, HIL fault drills): a suspended task's body returns at once.
+  // Names as in the task table; false if there is no such task.
+  bool suspend_task(const char* name, bool suspended);
+  ExplorationStatus status() const;
+  std::shared_ptr<const WorldModel> world() const { return world_.read().ptr; }
+  std::shared_ptr<const PlannedTrajectory> trajectory() const { return traj_.read().ptr; }
+  VelocityCommand last_command() const;
+  uint64_t safety_stops() const { return safety_stops_.load(std::memory_order_acquire); }
+  uint64_t stop_events(StopReason r) const {
+    return reason_events_[int(r)].load(std::memory_order_acquire);
+  }
+  uint32_t active_stop_mask() const { return stop_mask_.load(std::memory_order_acquire); }
+  uint64_t scans_dropped() const { return scans_dropped_.load(std::memory_order_relaxed); }
+
+  // Owner-side views for the run record, only while no task runs (after the lockstep loop or
+  // stop()): the live map (PLY export, coverage).
+  const core::map::TraversabilityMap& map_for_record() const { return map_; }
+
+ private:
+  enum Task { kIngest = 0, kMap, kPlan, kControl, kWatchdog, kTelemetry, kTaskCount };
+  std::vector<rt::TaskSpec> task_table();
+  bool suspended(Task t) const { return suspended_[t].load(std::memory_order_acquire); }
+  double now_s() const { return double(clock_.now_ns()) * 1e-9; }
+  void ingest_step();
+  void map_step();
+  void plan_step();
+  void control_step();
+  void watchdog_step();
+  void telemetry_step();
+  void log(const std::string& line) const;
+
+  Platform& platform_;
+  const rt::Clock& clock_;
+  AutonomyOptions opt_;
+  rt::TraceRing trace_;
+
+  // ingest -> map
+  std::vector<ScanBuffer> pool_;
+  rt::SpscQueue<ScanBuffer*> filled_q_, free_q_;
+  ScanBuffer* ingest_buf_ = nullptr;
+  ScanBuffer drop_buf_;
+  std::atomic<uint64_t> scans_dropped_{0};
+  rt::Mailbox<double> scan_stamp_mb_;
+  rt::Mailbox<PoseSample> pose_mb_;
+
+  // map task (owner of the world model)
+  core::map::TraversabilityMap map_;
+  core::graph::ReachableGraph graph_;
+  core::graph::TopologicalFrontiers frontiers_;
+  core::graph::FrontierClusters clusters_;
+  core::graph::ViewpointGenerator viewpoints_;
+  std::mt19937_64 rng_;
+  std::vector<core::graph::Aabb> changed_;
+  uint64_t map_cycle_ = 0, scans_inserted_ = 0;
+  rt::Snapshot<WorldModel> world_;
+
+  // plan task
+  core::plan::LocalPlanner planner_;
+  rt::Snapshot<PlannedTrajectory> traj_;
+  rt::Mailbox<double> plan_alive_mb_;
+  rt::Mailbox<ExplorationStatus> status_mb_;
+  std::atomic<bool> replan_request_{false};  // control -> plan: drop the current target
+  uint64_t traj_id_ = 0, plan_cycles_ = 0, trajectories_ = 0;
+  double idle_since_s_ = -1;
+  bool complete_ = false;
+
+  // control task
+  ControlLaw law_;
+  SafetyMonitor safety_;
+  core::plan::CollisionChecker lookahead_;
+  uint64_t ctl_traj_version_ = 0, ctl_checked_traj_ = 0, ctl_checked_map_ = 0;
+  std::shared_ptr<const PlannedTrajectory> ctl_traj_;
+  double tau_ = 0;  // progress along the trajectory [s] (advances while tracking well)
+  bool collision_predicted_ = false;
+  VelocityCommand prev_cmd_;
+  PoseSample last_pose_;
+  rt::Mailbox<VelocityCommand> cmd_mb_;
+  rt::SpscQueue<StopEvent> stop_q_;
+  std::atomic<uint64_t> safety_stops_{0};
+  std::atomic<uint64_t> reason_events_[int(StopReason::kCount)] = {};
+  std::atomic<uint32_t> stop_mask_{0};
+  std::atomic<bool> operator_stop_{false};
+
+  // watchdog
+  std::atomic<bool> overrun_flag_{false};
+  uint64_t wd_overruns_ = 0;
+
+  std::atomic<bool> suspended_[kTaskCount] = {};
+  std::unique_ptr<rt::Scheduler> sched_;
+};
+
+}  // namespace storey::firmware

@@ -1,0 +1,54 @@
+#include "firmware/control_law.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace storey::firmware {
+
+double wrap_angle(double a) {
+  a = std::remainder(a, 2.0 * M_PI);
+  return a <= -M_PI ? a + 2.0 * M_PI : a;
+}
+
+VelocityCommand ControlLaw::track(const core::plan::TrajectorySample& ref, const PoseSample& pose,
+                                  const VelocityCommand& prev, double dt_s) const {
+  // World-frame planar velocity: feedforward + P on the position error.
+  const double wx = ref.v_mps.x() + gains_.k_position * (ref.p_m.x() - pose.x_m);
+  const double wy = ref.v_mps.y() + gains_.k_position * (ref.p_m.y() - pose.y_m);
+  const double c = std::cos(pose.yaw_rad), s = std::sin(pose.yaw_rad);
+  VelocityCommand cmd;
+  cmd.vx_mps = c * wx + s * wy;  // rotate into the body frame
+  cmd.vy_mps = -s * wx + c * wy;
+  cmd.yaw_rate_rps = ref.yaw_rate_rps + gains_.k_yaw * wrap_angle(ref.yaw_rad - pose.yaw_rad);
+  return limit(cmd, prev, dt_s);
+}
+
+VelocityCommand ControlLaw::limit(VelocityCommand cmd, const VelocityCommand& prev,
+                                  double dt_s) const {
+  if (!std::isfinite(cmd.vx_mps) || !std::isfinite(cmd.vy_mps) ||
+      !std::isfinite(cmd.yaw_rate_rps)) {
+    cmd.vx_mps = cmd.vy_mps = cmd.yaw_rate_rps = 0;  // never forward a NaN to the robot
+  }
+  // Speed and yaw-rate limits.
+  const double v = std::hypot(cmd.vx_mps, cmd.vy_mps);
+  if (v > robot_.max_speed_mps) {
+    cmd.vx_mps *= robot_.max_speed_mps / v;
+    cmd.vy_mps *= robot_.max_speed_mps / v;
+  }
+  cmd.yaw_rate_rps =
+      std::clamp(cmd.yaw_rate_rps, -robot_.max_yaw_rate_rps, robot_.max_yaw_rate_rps);
+  // Acceleration limits against the previous command.
+  const double dv_max = robot_.max_accel_mps2 * dt_s;
+  const double dvx = cmd.vx_mps - prev.vx_mps, dvy = cmd.vy_mps - prev.vy_mps;
+  const double dv = std::hypot(dvx, dvy);
+  if (dv > dv_max) {
+    cmd.vx_mps = prev.vx_mps + dvx * dv_max / dv;
+    cmd.vy_mps = prev.vy_mps + dvy * dv_max / dv;
+  }
+  const double dw_max = robot_.max_yaw_accel_rps2 * dt_s;
+  cmd.yaw_rate_rps =
+      std::clamp(cmd.yaw_rate_rps, prev.yaw_rate_rps - dw_max, prev.yaw_rate_rps + dw_max);
+  return cmd;
+}
+
+}  // namespace storey::firmware
