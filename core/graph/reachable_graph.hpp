@@ -108,6 +108,10 @@ class ReachableGraph {
                           std::span<const Aabb> changed, std::mt19937_64& rng);
   // Queues every node for revalidation and expansion (e.g. after the options changed).
   void touch_all();
+  // Queues one node for expansion at the next update (a new topological frontier).
+  void request_expand(NodeId i) {
+    if (i < nodes_.size() && nodes_[i].alive) queue_expand(i);
+  }
   bool idle() const { return expand_q_.empty() && reval_q_.empty(); }
 
   const GraphNode& node(NodeId i) const { return nodes_[i]; }

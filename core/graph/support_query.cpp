@@ -167,6 +167,41 @@ map::Occupancy SupportQuery::walk(const Eigen::Vector3f& from, const Eigen::Vect
   return result;
 }
 
+bool SupportQuery::probe_open(const Eigen::Vector3f& from, const Eigen::Vector3f& to,
+                              float min_free_m, float min_unknown_m) {
+  const VoxelKey start{int32_t(std::floor(from.x() * inv_vs_)),
+                       int32_t(std::floor(from.y() * inv_vs_)),
+                       int32_t(std::floor(from.z() * inv_vs_))};
+  const Eigen::Vector3f d = to - from;
+  const float len = d.norm();
+  if (len <= 0) return false;
+  // Voxels visited per metre along the probe (6-connected walk: |dx| + |dy| + |dz| voxels).
+  const float per_m = (std::abs(d.x()) + std::abs(d.y()) + std::abs(d.z())) * inv_vs_ / len;
+  const int need_free = int(std::ceil(min_free_m * per_m));
+  const int need_unknown = std::max(1, int(std::ceil(min_unknown_m * per_m)));
+  int free_run = 0, unknown_run = 0;
+  bool open = false;
+  auto visit = [&](const VoxelKey& k) {
+    if (k == start) return true;
+    switch (occupancy(k)) {
+      case Occupancy::kOccupied:
+        return false;
+      case Occupancy::kFree:
+        ++free_run;
+        unknown_run = 0;
+        return true;
+      case Occupancy::kUnknown:
+        if (free_run < need_free) return false;  // did not start in known free space
+        open = ++unknown_run >= need_unknown;
+        return !open;
+    }
+    return false;
+  };
+  map::walk_ray(from.x() * inv_vs_, from.y() * inv_vs_, from.z() * inv_vs_, to.x() * inv_vs_,
+                to.y() * inv_vs_, to.z() * inv_vs_, visit);
+  return open;
+}
+
 Reject SupportQuery::classify_node(const Support& s, bool* confirmed) {
   *confirmed = false;
   if (s.state == TravState::kUntraversable || s.state == TravState::kNone)
@@ -178,6 +213,21 @@ Reject SupportQuery::classify_node(const Support& s, bool* confirmed) {
     *confirmed = true;
     return Reject::kNone;
   }
+  // Tentative support must have been seen from above: some voxel over it (before anything
+  // occupied) was crossed by a ray. The underside of a slab, seen only from below, has unknown
+  // space over it until the floor above is observed.
+  // Rays graze sparse ground from afar: the layer right above the surface in the 8 neighbour
+  // columns counts too (inside a slab it is unknown as well).
+  bool seen = false;
+  for (int dx = -1; dx <= 1 && !seen; ++dx)
+    for (int dy = -1; dy <= 1 && !seen; ++dy)
+      seen = free(cell({s.key.x + dx, s.key.y + dy, s.key.z + 1}));
+  for (int dz = 2; dz <= 3 && !seen; ++dz) {
+    const Cell* c = cell({s.key.x, s.key.y, s.key.z + dz});
+    if (occupied(c)) break;
+    seen = free(c);
+  }
+  if (!seen) return Reject::kNoSupport;
   // Tentative: collision-free and free of fall risk over under-observed ground (Sec. III-B).
   if (fall_risk(s.p_m)) return Reject::kFallRisk;
   return opt_.use_tentative ? Reject::kNone : Reject::kNotReachable;

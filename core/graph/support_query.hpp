@@ -80,6 +80,12 @@ class SupportQuery {
   map::Occupancy walk(const Eigen::Vector3f& from, const Eigen::Vector3f& to, bool stop_at_unknown,
                       float* free_m = nullptr);
 
+  // C_exp probe: walks from -> to; open if it crosses at least min_free_m of known free space
+  // and then min_unknown_m of contiguous unknown space before any occupied voxel. Unknown
+  // stretches shorter than that (stray unobserved voxels inside known space) are skipped.
+  bool probe_open(const Eigen::Vector3f& from, const Eigen::Vector3f& to, float min_free_m,
+                  float min_unknown_m);
+
   const map::MapView& view() const { return view_; }
   float voxel_size() const { return vs_; }
   float step() const { return step_; }

@@ -46,8 +46,8 @@ float TopologicalFrontiers::missing_surface_ratio(SupportQuery& q, const GraphNo
 }
 
 // C_exp: probes at body height along directions not covered by an edge (within alpha_min / 2);
-// open if the probe crosses known free space and then reaches unknown space without hitting an
-// obstacle first.
+// open if the probe crosses known free space and then reaches an unknown region (at least
+// probe_unknown_m of it) without hitting an obstacle first.
 int TopologicalFrontiers::open_directions(SupportQuery& q, const ReachableGraph& g, NodeId i) {
   const GraphNode& n = g.node(i);
   const int probes = std::max(1, opt_.probes);
@@ -67,8 +67,7 @@ int TopologicalFrontiers::open_directions(SupportQuery& q, const ReachableGraph&
     if (covered) continue;
     const Eigen::Vector3f to =
         from + float(opt_.probe_length_m) * Eigen::Vector3f(std::cos(th), std::sin(th), 0);
-    float free_m = 0;
-    if (q.walk(from, to, true, &free_m) == Occupancy::kUnknown && free_m >= min_free) ++open;
+    open += q.probe_open(from, to, min_free, float(opt_.probe_unknown_m));
   }
   return open;
 }
@@ -110,6 +109,13 @@ bool TopologicalFrontiers::near_reach_boundary(SupportQuery& q, const GraphNode&
 void TopologicalFrontiers::evaluate(ReachableGraph& g, SupportQuery& q, NodeId i) {
   GraphNode& n = g.mutable_node(i);
   if (!n.alive) return;
+  const bool was = n.frontier();
+  evaluate_flags(g, q, i);
+  if (n.frontier() && !was) g.request_expand(i);  // the graph may extend from here
+}
+
+void TopologicalFrontiers::evaluate_flags(ReachableGraph& g, SupportQuery& q, NodeId i) {
+  GraphNode& n = g.mutable_node(i);
   n.c_sur = n.c_exp = n.boundary = false;
   if (opt_.boundary_frontiers) {
     n.boundary = near_reach_boundary(q, n);

@@ -45,6 +45,7 @@ class TopologicalFrontiers {
   int open_directions(SupportQuery& q, const ReachableGraph& g, NodeId i);
   bool near_reach_boundary(SupportQuery& q, const GraphNode& n);
   void evaluate(ReachableGraph& g, SupportQuery& q, NodeId i);
+  void evaluate_flags(ReachableGraph& g, SupportQuery& q, NodeId i);
 
   GraphOptions opt_;
   std::vector<Eigen::Vector2f> disc_;  // Omega_i sample offsets (unit disc, sunflower pattern)

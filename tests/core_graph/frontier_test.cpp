@@ -199,9 +199,10 @@ TEST(TopologicalFrontiers, TableTopNeverGetsANode) {
   EXPECT_FALSE(top->reachable);
   ASSERT_GT(h.graph.node_count(), 20u);
   for (NodeId i = 0; i < h.graph.node_capacity(); ++i)
-    if (h.graph.node(i).alive)
+    if (h.graph.node(i).alive) {
       EXPECT_LT(h.graph.node(i).p_m.z(), 0.3f)
           << "node on the table at " << h.graph.node(i).p_m.transpose();
+    }
 }
 
 TEST(ViewpointGenerator, FieldOfViewOfVlp16AndMid360) {
@@ -246,7 +247,9 @@ TEST(ViewpointGenerator, BestKFacingTheClusterAndOccludedByWalls) {
       const Viewpoint& v = vps[c].viewpoints[k];
       EXPECT_GT(v.visible, 0);
       EXPECT_LE(v.visible, int(clusters[c].nodes.size()));
-      if (k) EXPECT_LE(v.visible, vps[c].viewpoints[k - 1].visible);
+      if (k) {
+        EXPECT_LE(v.visible, vps[c].viewpoints[k - 1].visible);
+      }
       const Vector3f d = clusters[c].centroid_m - v.p_m;
       if (std::hypot(d.x(), d.y()) > 0.05f) {
         EXPECT_NEAR(std::remainder(v.yaw_rad - std::atan2(d.y(), d.x()), 2 * M_PI), 0, 1e-4);
