@@ -1,0 +1,165 @@
+#include "core/plan/exploration_planner.hpp"
+
+#include <gtest/gtest.h>
+
+#include "macro_world.hpp"
+#include "toy_graph.hpp"
+
+using namespace storey::core::plan;
+using storey::test::macro::Harness;
+using storey::test::macro::ToyGraph;
+using storey::test::macro::World;
+
+namespace {
+
+// Floor 0 slab, a straight staircase of 17 x 0.17 m along +x, floor 1 slab at 2.89 m with two
+// rooms (wall at x = 12 with a door) above a hall.
+World two_floors() {
+  World w;
+  w.add({-1, -1, -0.2f}, {10, 6, 0});
+  w.stairs(2, 4, 5, 0, 17, 0.17f, 0.28f);
+  w.add({-1, -1, 2.69f}, {18, 3.5f, 2.89f});
+  return w;
+}
+
+ExplorationInput input(const Harness& h, const storey::core::map::MapView& view,
+                       const Eigen::Vector3f& foot, double t) {
+  ExplorationInput in;
+  in.view = &view;
+  in.map_version = h.map.version();
+  in.graph = &h.graph;
+  in.clusters = &h.clusters.clusters();
+  in.viewpoints = &h.viewpoints.viewpoints();
+  in.robot_foot_m = foot.cast<double>();
+  in.t_s = t;
+  return in;
+}
+
+}  // namespace
+
+TEST(ExplorationPlanner, FloorChangeBuildsThePriorOnlyWithUsePrior) {
+  const World w = two_floors();
+  for (bool use_prior : {true, false}) {
+    Harness h;
+    PlanOptions opt;
+    opt.use_prior = use_prior;
+    ExplorationPlanner planner({}, opt, 0.1);
+    double t = 0;
+    // Explore floor 0 a little.
+    for (const Eigen::Vector3f foot : {Eigen::Vector3f(1, 2, 0), Eigen::Vector3f(4, 2, 0)}) {
+      h.observe(w, foot, 20000, uint32_t(t * 10) + 1);
+      const auto view = h.map.view();
+      const ExplorationResult r = planner.plan(input(h, view, foot, t));
+      EXPECT_EQ(r.floor, 0);
+      EXPECT_FALSE(r.prior_built);
+      t += 1.0;
+    }
+    // Up the stairs and onto floor 1: the floor changes once the height is stable.
+    bool changed = false, built = false;
+    int32_t ref = -1;
+    double dz = 0;
+    for (int i = 0; i <= 17; ++i, t += 0.5) {
+      const Eigen::Vector3f foot(2.14f + 0.28f * float(i), 4.5f, 0.17f * float(i));
+      const auto view = h.map.view();
+      changed = changed || planner.plan(input(h, view, foot, t)).floor_changed;
+    }
+    EXPECT_FALSE(changed) << "a floor change during the climb";
+    for (int i = 0; i < 8; ++i, t += 0.5) {
+      const Eigen::Vector3f foot(8, 2, 2.89f);
+      h.observe(w, foot, 20000, 100 + uint32_t(i));
+      const auto view = h.map.view();
+      const ExplorationResult r = planner.plan(input(h, view, foot, t));
+      if (r.floor_changed) {
+        changed = true;
+        built = r.prior_built;
+        ref = r.reference_floor;
+        dz = r.dz_m;
+        EXPECT_EQ(r.floor, 1);
+      }
+    }
+    EXPECT_TRUE(changed);
+    EXPECT_EQ(planner.floors().current(), 1);
+    EXPECT_EQ(built, use_prior);
+    EXPECT_EQ(planner.hybrid().has_prior(), use_prior);
+    if (use_prior) {
+      EXPECT_EQ(ref, 0);
+      EXPECT_NEAR(dz, 2.89, 0.15);
+      EXPECT_GT(planner.hybrid().hypotheses_alive() + planner.hybrid().nodes().size(), 0u);
+    }
+  }
+}
+
+TEST(ExplorationPlanner, CompleteWhenNoFrontiersAndNoZonesRemain) {
+  World w;
+  w.add({-1, -1, -0.2f}, {5, 5, 0});
+  Harness h;
+  const Eigen::Vector3f foot(2, 2, 0);
+  h.observe(w, foot, 20000, 3);
+  ExplorationPlanner planner({}, PlanOptions{}, 0.1);
+  const auto view = h.map.view();
+  ExplorationInput in = input(h, view, foot, 0.0);
+  const std::vector<storey::core::graph::FrontierCluster> none;
+  const std::vector<storey::core::graph::ClusterViewpoints> no_vp;
+  in.clusters = &none;
+  in.viewpoints = &no_vp;
+  const ExplorationResult r = planner.plan(in);
+  EXPECT_EQ(r.status, ExplorationStatus::kComplete) << r.reason;
+  EXPECT_NE(std::string(r.reason).find("no uncompleted zone"), std::string::npos);
+  // With frontiers present the planner is not complete.
+  const ExplorationResult r2 = planner.plan(input(h, view, foot, 1.0));
+  if (!h.clusters.clusters().empty()) EXPECT_NE(r2.status, ExplorationStatus::kComplete);
+}
+
+TEST(ExplorationPlanner, BadInputIsAFailureWithAReason) {
+  ExplorationPlanner planner({}, PlanOptions{}, 0.1);
+  const ExplorationResult r = planner.plan(ExplorationInput{});
+  EXPECT_EQ(r.status, ExplorationStatus::kFailed);
+  EXPECT_NE(std::string(r.reason), "");
+}
+
+TEST(GlobalPlanner, VisitsTheNearerHypotheticalZoneFirst) {
+  // Prior: three rooms in a row joined by doors, one zone each. Target floor: only room A is
+  // observed; B and C are hypothetical zones, B nearer.
+  ToyGraph t;
+  t.add_room({0, 0, 6, 5}, 0.8, 0);
+  t.add_room({6.2, 0, 12, 5}, 0.8, 1);
+  t.add_room({12.2, 0, 18, 5}, 0.8, 2);
+  t.link(t.nearest({5.6, 2.4, 0}), t.nearest({6.6, 2.4, 0}));
+  t.link(t.nearest({11.8, 2.4, 0}), t.nearest({12.6, 2.4, 0}));
+  const SearchGraph g = t.csr();
+  TaskZonePartitioner part;
+  const ZonePartition zones = part.partition(g, t.clearance, {5.0, 4});
+  World w;
+  w.add({-1, -1, -0.2f}, {6, 6, 0});
+  Harness h;
+  const Eigen::Vector3f foot(2, 2.5f, 0);
+  h.observe(w, foot, 20000, 5);
+  FloorTracker ft;
+  ft.update(0, 0);
+  HybridGraph hg;
+  hg.init_prior(g, zones, 0.0, 0);
+  PlanOptions opt;
+  hg.update(h.map.view(), h.map.version(), h.graph, ft, foot.cast<double>(), opt);
+  const uint32_t robot = hg.node_of_real(h.graph.root());
+  ASSERT_NE(robot, kNoNode);
+  GlobalPlanner gp;
+  const GlobalPlan plan = gp.plan(hg, robot, [](int32_t) { return false; });
+  ASSERT_TRUE(plan.ok);
+  // Mean x of each zone in the visiting order must increase (A/B/C left to right).
+  std::vector<double> xs;
+  for (int32_t id : plan.zone_order)
+    for (const HybridZone& z : hg.zones())
+      if (z.id == id) xs.push_back(z.centroid_m.x());
+  ASSERT_GE(xs.size(), 2u);
+  for (size_t i = 1; i < xs.size(); ++i) EXPECT_LT(xs[i - 1], xs[i]);
+  EXPECT_GT(plan.hybrid_rows, 0);
+  // The path to the farthest zone leaves the real graph: only its real prefix is driven.
+  uint32_t far_centre = kNoNode;
+  for (const HybridZone& z : hg.zones())
+    if (z.id == plan.zone_order.back()) far_centre = z.centre;
+  const Approach a = gp.approach(hg, robot, far_centre);
+  ASSERT_TRUE(a.ok);
+  EXPECT_TRUE(a.used_hybrid);
+  EXPECT_LT(a.real_prefix, a.path.size());
+  EXPECT_LT(a.goal_m.x(), 6.6);
+}
