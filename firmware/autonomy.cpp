@@ -147,8 +147,6 @@ void Autonomy::ingest_step() {
 // viewpoints; publish the world model.
 void Autonomy::map_step() {
   if (suspended(kMap)) return;
-  if (getenv("STOREY_DEBUG"))
-    fprintf(stderr, "map_step t=%.2f filled %zu\n", now_s(), filled_q_.size_approx());
   ScanBuffer* b = nullptr;
   while (filled_q_.try_pop(b)) {
     map_.insert_scan(b->origin_m, b->points_m);
@@ -160,7 +158,7 @@ void Autonomy::map_step() {
   if (pose_mb_.read(pose) == 0) return;  // no odometry yet: C_reach needs the robot's foot
   const Eigen::Vector3f foot = pose.position().cast<float>();
   map_.update_traversability();
-  const auto rs = map_.update_reachable(foot);
+  map_.update_reachable(foot);
   const core::map::MapView view = map_.view();
   // Until G_real has a node near the robot, anchor it at the latest C_reach seed: the ground
   // under the feet is in the LiDAR's blind ring, the seed is the nearest observed support.
@@ -170,15 +168,7 @@ void Autonomy::map_step() {
     anchor = view.centre_of(k);
     if (const auto h = view.surface_height_m(k)) anchor.z() = *h;
   }
-  const auto gs = graph_.update(view, anchor, changed_, rng_);
-  if (getenv("STOREY_DEBUG"))
-    fprintf(stderr,
-            "map t=%.2f foot %.2f %.2f %.2f seed %d reach %lu trav %lu occ %lu nodes %zu root %d "
-            "rej %u %u %u %u %u %u\n",
-            now_s(), foot.x(), foot.y(), foot.z(), rs.has_seed,
-            (unsigned long)map_.reachable_voxels(), (unsigned long)map_.traversable_voxels(),
-            (unsigned long)map_.occupied_voxels(), graph_.node_count(), gs.has_root, gs.rejects[0],
-            gs.rejects[1], gs.rejects[2], gs.rejects[3], gs.rejects[4], gs.rejects[5]);
+  graph_.update(view, anchor, changed_, rng_);
   const core::graph::FrontierUpdateStats fs = frontiers_.update(graph_, view, foot, changed_);
   const auto& clusters = clusters_.update(graph_);
   const auto& vps = viewpoints_.update(graph_, view, clusters);

@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <map>
 
 #include "core/plan/plan_config.hpp"
@@ -82,10 +80,6 @@ bool LocalPlanner::try_target(const LocalPlanInput& in, const Viewpoint& vp, Loc
     if (path.status == VoxelAStarStatus::kOk)
       path.points_m.insert(path.points_m.begin(), in.robot_foot_m);
   }
-  if (getenv("STOREY_DEBUG"))
-    fprintf(stderr, "astar to %.2f %.2f %.2f from %.2f %.2f %.2f: %s n=%zu\n", vp.p_m.x(),
-            vp.p_m.y(), vp.p_m.z(), in.robot_foot_m.x(), in.robot_foot_m.y(), in.robot_foot_m.z(),
-            to_string(path.status), path.points_m.size());
   if (path.status != VoxelAStarStatus::kOk && vp.node < sg_.num_nodes() &&
       robot_node_ < sg_.num_nodes()) {
     // Fallback: the path along G_real. Its edges were checked over the support surface by the
@@ -107,7 +101,6 @@ bool LocalPlanner::try_target(const LocalPlanInput& in, const Viewpoint& vp, Loc
   path.points_m.front() = in.robot_foot_m;
   TrajectoryResult tr =
       builder_.build(*in.view, checker_, path.points_m, in.robot_yaw_rad, vp.yaw_rad, in.t_s);
-  if (getenv("STOREY_DEBUG")) fprintf(stderr, "traj %s\n", to_string(tr.status));
   if (tr.status != TrajectoryStatus::kOk && tr.status != TrajectoryStatus::kPolyline) return false;
   out.trajectory = std::move(tr.trajectory);
   out.path_m = std::move(path.points_m);
