@@ -42,8 +42,8 @@ struct GraphOptions {
   // --- frontiers (Sec. III-C) ---
   int surface_samples = 32;        // |Omega_i|: samples of the disc, Eq. 5
   double probe_height_m = 0.3;     // C_exp probes run this far above the node's support
-  double probe_unknown_m = 0.3;    // C_exp: a probe is open once it has crossed this much
-                                   // contiguous unknown space (a region, not a stray voxel)
+  double probe_unknown_m = 0.3;    // C_exp: a probe is open if its last this-many metres are
+                                   // unknown (it ends in an unknown region, not a hole)
   double boundary_radius_m = 0.5;  // boundary ablation: C_reach boundary voxels this close
   // --- viewpoints (Sec. III-C, last paragraph) ---
   double viewpoint_target_height_m = 0.15;  // rays aim this far above a frontier node's support

@@ -179,27 +179,33 @@ bool SupportQuery::probe_open(const Eigen::Vector3f& from, const Eigen::Vector3f
   const float per_m = (std::abs(d.x()) + std::abs(d.y()) + std::abs(d.z())) * inv_vs_ / len;
   const int need_free = int(std::ceil(min_free_m * per_m));
   const int need_unknown = std::max(1, int(std::ceil(min_unknown_m * per_m)));
-  int free_run = 0, unknown_run = 0;
-  bool open = false;
+  int free_total = 0, unknown_run = 0;
+  bool hit = false;
   auto visit = [&](const VoxelKey& k) {
     if (k == start) return true;
     switch (occupancy(k)) {
       case Occupancy::kOccupied:
+        hit = true;
         return false;
       case Occupancy::kFree:
-        ++free_run;
-        unknown_run = 0;
+        ++free_total;
+        unknown_run = 0;  // an enclosed hole in known space, not an unknown region
         return true;
       case Occupancy::kUnknown:
-        if (free_run < need_free) return false;  // did not start in known free space
-        open = ++unknown_run >= need_unknown;
-        return !open;
+        if (free_total < need_free) {  // did not start in known free space
+          hit = true;
+          return false;
+        }
+        ++unknown_run;
+        return true;
     }
     return false;
   };
   map::walk_ray(from.x() * inv_vs_, from.y() * inv_vs_, from.z() * inv_vs_, to.x() * inv_vs_,
                 to.y() * inv_vs_, to.z() * inv_vs_, visit);
-  return open;
+  // Open: the probe ends inside an unknown region (at least min_unknown_m of it) that it
+  // entered from known free space, with no obstacle on the way.
+  return !hit && unknown_run >= need_unknown;
 }
 
 Reject SupportQuery::classify_node(const Support& s, bool* confirmed) {

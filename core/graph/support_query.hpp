@@ -80,9 +80,10 @@ class SupportQuery {
   map::Occupancy walk(const Eigen::Vector3f& from, const Eigen::Vector3f& to, bool stop_at_unknown,
                       float* free_m = nullptr);
 
-  // C_exp probe: walks from -> to; open if it crosses at least min_free_m of known free space
-  // and then min_unknown_m of contiguous unknown space before any occupied voxel. Unknown
-  // stretches shorter than that (stray unobserved voxels inside known space) are skipped.
+  // C_exp probe: walks from -> to; open if it starts with at least min_free_m of known free
+  // space, hits nothing occupied, and ends in an unknown region (the last min_unknown_m of the
+  // probe unknown). Unknown holes enclosed by free space (gaps in the ray coverage) are not
+  // regions and do not open a probe.
   bool probe_open(const Eigen::Vector3f& from, const Eigen::Vector3f& to, float min_free_m,
                   float min_unknown_m);
 
