@@ -157,6 +157,7 @@ void Autonomy::map_step() {
   PoseSample pose;
   if (pose_mb_.read(pose) == 0) return;  // no odometry yet: C_reach needs the robot's foot
   const Eigen::Vector3f foot = pose.position().cast<float>();
+  if (!startup_support_done_ && scans_inserted_ > 0) insert_startup_support(foot);
   map_.update_traversability();
   map_.update_reachable(foot);
   const core::map::MapView view = map_.view();
@@ -187,6 +188,33 @@ void Autonomy::map_step() {
   w->frontier_nodes = fs.frontiers;
   w->scans = scans_inserted_;
   world_.publish(std::shared_ptr<const WorldModel>(std::move(w)));
+}
+
+// Start-up support (once): the robot stands on ground its LiDAR cannot see (the blind ring of
+// radius h / tan(-v_min) around it). Its legs measure that ground, so the firmware enters it as
+// observed support: points at foot height on a 3.3 cm grid within the blind radius, each kept
+// only if the line of sight from the sensor to it is free in the first scans (walls and drops
+// already seen clip it). Without it a VLP-16 in a 2 m corridor sees no floor to start from.
+void Autonomy::insert_startup_support(const Eigen::Vector3f& foot) {
+  startup_support_done_ = true;
+  const double down = -opt_.fov.v_min_deg * M_PI / 180.0;
+  if (down <= 0.01 || opt_.startup_support_radius_m <= 0) return;
+  const float r = float(
+      std::min(opt_.startup_support_radius_m, opt_.fov.mount_height_m / std::tan(down) + 0.3));
+  const Eigen::Vector3f origin = foot + Eigen::Vector3f(0, 0, float(opt_.fov.mount_height_m));
+  const core::map::MapView view = map_.view();
+  std::vector<Eigen::Vector3f> pts;
+  const float step = 0.033f;
+  for (float x = -r; x <= r; x += step)
+    for (float y = -r; y <= r; y += step) {
+      if (x * x + y * y > r * r) continue;
+      const Eigen::Vector3f p = foot + Eigen::Vector3f(x, y, -0.01f);
+      if (view.first_occupied(origin, p + Eigen::Vector3f(0, 0, 0.12f))) continue;
+      pts.push_back(p);
+    }
+  map_.insert_scan(origin, pts);
+  changed_.push_back(core::graph::scan_bounds(origin, pts));
+  startup_points_ = pts.size();
 }
 
 // ---- plan (2 Hz): local layer (Stage 1-3) on the latest world model.

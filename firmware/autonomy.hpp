@@ -93,7 +93,10 @@ struct AutonomyOptions {
   // not wait for a slow task, and wall-time overruns would make the run non-deterministic.
   bool stop_on_overruns = true;
   double complete_after_s = 3.0;  // no target for this long with a settled graph = complete
-  size_t scan_pool = 4;           // scan buffers in flight (ingest -> map)
+  // Ground under the robot at start-up, which the LiDAR cannot see, entered as support up to
+  // this radius (capped at the blind radius + 0.3 m; 0 = off). See insert_startup_support().
+  double startup_support_radius_m = 3.0;
+  size_t scan_pool = 4;  // scan buffers in flight (ingest -> map)
   size_t scan_reserve_points = 65536;
   size_t trace_events = 1 << 16;
   double lockstep_event_hz = 100;               // how often the ingest row is polled in lockstep
@@ -139,6 +142,7 @@ class Autonomy {
   double now_s() const { return double(clock_.now_ns()) * 1e-9; }
   void ingest_step();
   void map_step();
+  void insert_startup_support(const Eigen::Vector3f& foot);
   void plan_step();
   void control_step();
   void watchdog_step();
@@ -168,6 +172,8 @@ class Autonomy {
   std::mt19937_64 rng_;
   std::vector<core::graph::Aabb> changed_;
   uint64_t map_cycle_ = 0, scans_inserted_ = 0;
+  bool startup_support_done_ = false;
+  size_t startup_points_ = 0;
   rt::Snapshot<WorldModel> world_;
 
   // plan task
