@@ -127,10 +127,19 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     const bool reached =
         dxy <= opt_.reached_radius_m && std::abs(in.robot_foot_m.z() - target_m_.z()) < 0.5;
     if (reached || in.t_s > current_.t_end() + 3.0) {
-      // Stood at the viewpoint (or should have long ago): whatever of the cluster is still a
-      // frontier cannot be resolved from here.
-      if (tc)
-        for (graph::NodeId n : tc->nodes) set_aside_.push_back(g.node(n).p_m);
+      // Stood at the viewpoint (or should have long ago) and the cluster is still there. First
+      // walk onto the frontier itself (the LiDAR's blind ring moves with the robot, so the
+      // ground beyond a frontier is often only seen from on top of it); if it still persists,
+      // it cannot be resolved from where the robot can stand: set it aside.
+      if (tc) {
+        const bool approached =
+            std::find(approached_.begin(), approached_.end(), target_cluster_) != approached_.end();
+        if (approached || !reached) {
+          for (graph::NodeId n : tc->nodes) set_aside_.push_back(g.node(n).p_m);
+        } else {
+          approached_.push_back(target_cluster_);
+        }
+      }
       reason = reached ? "target reached" : "target overdue";
       has_target_ = false;
     } else if (!tc) {
@@ -262,6 +271,9 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
         v.push_back({gv.p_m.cast<double>(), double(gv.yaw_rad), gv.node});
       }
     }
+    const bool approach =
+        std::find(approached_.begin(), approached_.end(), c.cluster_id) != approached_.end();
+    if (approach) v.clear();  // second visit: onto the frontier node itself
     if (v.empty()) {  // no scored viewpoint: stand on the representative, facing the centroid
       const auto& cl = (*in.clusters)[c.cluster_index];
       const Eigen::Vector3f p = g.node(c.rep).p_m;

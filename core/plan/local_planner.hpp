@@ -125,6 +125,8 @@ class LocalPlanner {
   // Frontier nodes set aside (positions: node ids are recycled) and Stage 3 failures per cluster.
   std::vector<Eigen::Vector3f> set_aside_;
   std::vector<std::pair<int32_t, int>> failures_;
+  std::vector<int32_t>
+      approached_;  // clusters whose viewpoint was reached once (walk onto them next)
 };
 
 }  // namespace storey::core::plan
