@@ -93,6 +93,7 @@ void read_map(SectionReader&& r, core::map::MapOptions& o) {
   r.get("collision_radius_m", o.collision_radius_m, Range{0.0, 2.0});
   r.get("seed_search_radius_m", o.seed_search_radius_m, Range{0.0, 10.0});
   r.get("world_limit_m", o.world_limit_m, Range{10.0, 1e7});
+  r.get("ray_early_stop_voxels", o.ray_early_stop_voxels, Range{0, 100000});
 }
 
 void read_graph(SectionReader&& r, core::graph::GraphOptions& o) {
@@ -121,6 +122,7 @@ void read_graph(SectionReader&& r, core::graph::GraphOptions& o) {
   r.get("floor_height_hint_m", o.floor_height_hint_m, Range{1.0, 20.0});
   r.get("max_expansions_per_update", o.max_expansions_per_update, Range{1, 1000000});
   r.get("max_revalidations_per_update", o.max_revalidations_per_update, Range{1, 10000000});
+  r.get("max_frontier_updates", o.max_frontier_updates, Range{1, 10000000});
   r.get("surface_samples", o.surface_samples, Range{1, 4096});
   r.get("probe_height_m", o.probe_height_m, Range{0.0, 3.0});
   r.get("boundary_radius_m", o.boundary_radius_m, Range{0.01, 10.0});
@@ -139,6 +141,16 @@ void read_plan(SectionReader&& r, core::plan::PlanOptions& o) {
   r.get("floor_change_dz_m", o.floor_change_dz_m, Range{0.3, 10.0});
   r.get("hyp_discard_observations", o.hyp_discard_observations, Range{1, 1000});
   r.get("hyp_promote_radius_m", o.hyp_promote_radius_m, Range{0.01, 10.0});
+  r.get("tsp_exact_max_n", o.tsp_exact_max_n, Range{1, 16});
+  r.get("heading_via_viewpoint_yaw", o.heading_via_viewpoint_yaw);
+  r.get("astar_max_expansions", o.astar_max_expansions, Range{100, 100000000});
+  r.get("astar_reachable_only", o.astar_reachable_only);
+  r.get("astar_cost_weight", o.astar_cost_weight, kNonNegWeight);
+  r.get("astar_clearance_weight", o.astar_clearance_weight, kNonNegWeight);
+  r.get("astar_goal_tolerance_m", o.astar_goal_tolerance_m, Range{0.0, 5.0});
+  r.get("traj_control_spacing_m", o.traj_control_spacing_m, Range{0.05, 5.0});
+  r.get("traj_max_repairs", o.traj_max_repairs, Range{0, 1000});
+  r.get("lookahead_s", o.lookahead_s, Range{0.1, 10.0});
   r.get("use_prior", o.use_prior);
   r.get("incremental_maintenance", o.incremental_maintenance);
 }
