@@ -87,7 +87,7 @@ std::vector<rt::TaskSpec> Autonomy::task_table() {
   auto row = [](const char* name, const config::TaskRate& tr, std::function<void()> fn) {
     return rt::TaskSpec{name, tr.rate_hz, tr.budget_us, tr.priority, tr.cpu, std::move(fn), -1};
   };
-  return {
+  std::vector<rt::TaskSpec> table = {
       //  name         rate/budget/prio/cpu   body
       row(kTaskNames[kIngest], r.ingest, [this] { ingest_step(); }),        // event-driven (polled)
       row(kTaskNames[kMap], r.map, [this] { map_step(); }),                 // 10 Hz
@@ -96,6 +96,8 @@ std::vector<rt::TaskSpec> Autonomy::task_table() {
       row(kTaskNames[kWatchdog], r.watchdog, [this] { watchdog_step(); }),  // 10 Hz
       row(kTaskNames[kTelemetry], r.telemetry, [this] { telemetry_step(); }),  // 1 Hz
   };
+  table[kIngest].fd = opt_.ingest_fd;  // real time: runs when the LiDAR socket is readable
+  return table;
 }
 
 bool Autonomy::suspend_task(const char* name, bool on) {

@@ -99,6 +99,8 @@ struct AutonomyOptions {
   size_t scan_pool = 4;  // scan buffers in flight (ingest -> map)
   size_t scan_reserve_points = 65536;
   size_t trace_events = 1 << 16;
+  // Real time: the LiDAR socket (the ingest task runs when it is readable); lockstep: unused.
+  int ingest_fd = -1;
   double lockstep_event_hz = 100;               // how often the ingest row is polled in lockstep
   std::function<void(const std::string&)> log;  // non-RT log sink (telemetry task); default stderr
 };
