@@ -7,28 +7,47 @@ namespace storey::core::graph {
 
 using map::Cell;
 
-uint64_t MapChangeDetector::signature(const map::VoxelBlock& b, int16_t occ_q) const {
-  uint64_t h = 1469598103934665603ull;  // FNV-1a over one byte per voxel
+MapChangeDetector::Sig MapChangeDetector::signature(const map::VoxelBlock& b, int16_t occ_q) const {
+  Sig s;
+  s.hash = 1469598103934665603ull;  // FNV-1a over one byte per voxel
   for (const Cell& c : b.cells) {
     const uint8_t occ = !(c.flags & Cell::kObserved) ? 0 : (c.log_odds > occ_q ? 2 : 1);
     const uint8_t v = uint8_t(occ | (uint8_t(c.state) << 2) | ((c.flags & Cell::kReachable) << 3));
-    h = (h ^ v) * 1099511628211ull;
+    s.hash = (s.hash ^ v) * 1099511628211ull;
+    s.occupied += occ == 2;
   }
-  return h;
+  return s;
+}
+
+void MapChangeDetector::emit(std::vector<uint64_t>& cells, std::vector<Aabb>& out) {
+  std::sort(cells.begin(), cells.end());
+  cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
+  for (uint64_t k : cells) {
+    // Unpack the 21-bit two's complement coordinates.
+    auto coord = [](uint64_t v) { return int32_t(uint32_t(v << 11)) >> 11; };
+    const int32_t cx = coord((k >> 42) & 0x1FFFFF), cy = coord((k >> 21) & 0x1FFFFF),
+                  cz = coord(k & 0x1FFFFF);
+    Aabb b;
+    b.lo = Eigen::Vector3f(float(cx), float(cy), float(cz)) * cell_m_;
+    b.hi = b.lo + Eigen::Vector3f::Constant(cell_m_);
+    out.push_back(b);
+  }
 }
 
 size_t MapChangeDetector::detect(const map::MapView& view, std::span<const Aabb> regions,
-                                 std::vector<Aabb>& out) {
+                                 std::vector<Aabb>& out, std::vector<Aabb>* opened) {
   const int16_t occ_q = int16_t(std::lround(view.options().log_odds_occupied * map::kLogOddsScale));
   const double block_m = view.voxel_size_m() * map::kBlockDim;
   const map::BlockStore& store = view.store();
   cells_.clear();
+  opened_cells_.clear();
   size_t changed = 0;
   auto check = [&](const map::VoxelBlock& b) {
     const uint64_t key = map::pack_block_key(b.bx, b.by, b.bz);
-    const uint64_t s = signature(b, occ_q);
+    const Sig s = signature(b, occ_q);
     auto [it, fresh] = sig_.try_emplace(key, s);
-    if (!fresh && it->second == s) return;
+    if (!fresh && it->second.hash == s.hash) return;
+    const bool lost = !fresh && s.occupied < it->second.occupied;
     it->second = s;
     ++changed;
     const Eigen::Vector3f centre =
@@ -38,6 +57,7 @@ size_t MapChangeDetector::detect(const map::MapView& view, std::span<const Aabb>
     const int32_t cy = int32_t(std::floor(centre.y() / cell_m_));
     const int32_t cz = int32_t(std::floor(centre.z() / cell_m_));
     cells_.push_back(map::pack_block_key(cx, cy, cz));
+    if (lost) opened_cells_.push_back(cells_.back());
   };
   for (const Aabb& r : regions) {
     if (r.empty()) continue;
@@ -60,18 +80,8 @@ size_t MapChangeDetector::detect(const map::MapView& view, std::span<const Aabb>
         for (int32_t bz = z0; bz <= z1; ++bz)
           if (const map::VoxelBlock* b = store.find(map::pack_block_key(bx, by, bz))) check(*b);
   }
-  std::sort(cells_.begin(), cells_.end());
-  cells_.erase(std::unique(cells_.begin(), cells_.end()), cells_.end());
-  for (uint64_t k : cells_) {
-    // Unpack the 21-bit two's complement coordinates.
-    auto coord = [](uint64_t v) { return int32_t(v << 11) >> 11; };
-    const int32_t cx = coord((k >> 42) & 0x1FFFFF), cy = coord((k >> 21) & 0x1FFFFF),
-                  cz = coord(k & 0x1FFFFF);
-    Aabb b;
-    b.lo = Eigen::Vector3f(float(cx), float(cy), float(cz)) * cell_m_;
-    b.hi = b.lo + Eigen::Vector3f::Constant(cell_m_);
-    out.push_back(b);
-  }
+  emit(cells_, out);
+  if (opened) emit(opened_cells_, *opened);
   return changed;
 }
 

@@ -19,17 +19,24 @@ namespace storey::core::graph {
 
 class MapChangeDetector {
  public:
-  explicit MapChangeDetector(float super_cell_m = 3.2f) : cell_m_(super_cell_m) {}
-  // Appends to `out` one box per super-cell holding a changed block; returns the number of
-  // changed blocks.
-  size_t detect(const map::MapView& view, std::span<const Aabb> regions, std::vector<Aabb>& out);
+  explicit MapChangeDetector(float super_cell_m = 1.6f) : cell_m_(super_cell_m) {}
+  // Appends to `out` one box per super-cell holding a changed block, and to `opened` (if
+  // given) one per super-cell holding a block that lost occupied voxels (something was removed:
+  // a door opened, an obstacle left); returns the number of changed blocks.
+  size_t detect(const map::MapView& view, std::span<const Aabb> regions, std::vector<Aabb>& out,
+                std::vector<Aabb>* opened = nullptr);
   size_t tracked_blocks() const { return sig_.size(); }
 
  private:
-  uint64_t signature(const map::VoxelBlock& b, int16_t occ_q) const;
+  struct Sig {
+    uint64_t hash = 0;
+    uint32_t occupied = 0;
+  };
+  Sig signature(const map::VoxelBlock& b, int16_t occ_q) const;
+  void emit(std::vector<uint64_t>& cells, std::vector<Aabb>& out);
   float cell_m_;
-  std::unordered_map<uint64_t, uint64_t> sig_;
-  std::vector<uint64_t> cells_;
+  std::unordered_map<uint64_t, Sig> sig_;
+  std::vector<uint64_t> cells_, opened_cells_;
 };
 
 }  // namespace storey::core::graph

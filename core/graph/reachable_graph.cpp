@@ -177,6 +177,7 @@ EdgeId ReachableGraph::add_edge(NodeId a, NodeId b, const EdgeCheck& ec) {
   e.state = edge_state(a, b, ec);
   e.length_m = ec.length_m;
   e.cost = ec.length_m * (1.0f + ec.mean_cost);
+  e.checked = cycle_;
   nodes_[a].edges[nodes_[a].degree++] = id;
   nodes_[b].edges[nodes_[b].degree++] = id;
   ++edge_count_;
@@ -264,6 +265,8 @@ void ReachableGraph::revalidate(SupportQuery& q, NodeId i, GraphUpdateStats& st)
   for (int k = n.degree - 1; k >= 0; --k) {
     const EdgeId e = n.edges[k];
     const NodeId o = edges_[e].other(i);
+    if (edges_[e].checked == cycle_) continue;  // already re-checked from its other end
+    edges_[e].checked = cycle_;
     const EdgeCheck ec = q.check_edge(n.p_m, nodes_[o].p_m);
     const ElementState es = ec.valid() ? edge_state(i, o, ec) : ElementState::kTentative;
     if (!ec.valid() || (!opt_.use_tentative && es != ElementState::kConfirmed)) {
@@ -421,6 +424,7 @@ GraphUpdateStats ReachableGraph::update(const map::MapView& view, const Eigen::V
   GraphUpdateStats st;
   SupportQuery q(view, opt_);
   connectivity_lost_ = false;
+  ++cycle_;
   // 1. The affected subgraph: nodes in the changed regions inflated by the reach of their
   //    edges and expansion candidates, nearest to the robot first.
   const float reach = float(opt_.neighbour_radius_factor * opt_.r_e_m);

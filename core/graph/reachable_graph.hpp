@@ -76,8 +76,9 @@ struct GraphEdge {
   NodeId a = kNoId, b = kNoId;
   ElementState state = ElementState::kTentative;
   bool alive = false;
-  float length_m = 0;  // along the support surface
-  float cost = 0;      // length * (1 + mean c(v)), Eq. 2 along the edge
+  float length_m = 0;    // along the support surface
+  float cost = 0;        // length * (1 + mean c(v)), Eq. 2 along the edge
+  uint32_t checked = 0;  // update cycle that last re-checked it (each edge once per cycle)
   NodeId other(NodeId n) const { return n == a ? b : a; }
 };
 
@@ -169,6 +170,7 @@ class ReachableGraph {
   std::vector<NodeId> scratch_, bfs_;
   std::vector<uint32_t> mark_;
   uint32_t mark_epoch_ = 0;
+  uint32_t cycle_ = 0;
 };
 
 }  // namespace storey::core::graph

@@ -219,6 +219,16 @@ Reject SupportQuery::classify_node(const Support& s, bool* confirmed) {
     *confirmed = true;
     return Reject::kNone;
   }
+  // Tentative: the whole body footprint (half length + margin around the node) is clear.
+  const RobotModel& r = view_.robot();
+  const float reach = float(0.5 * r.body_length_m + r.body_margin_m) - lateral_m_;
+  for (int k = 0; k < 8; ++k) {
+    const float a = float(k) * float(M_PI) / 4.0f;
+    const Eigen::Vector2f dir(std::cos(a), std::sin(a));
+    if (!body_clear(s.p_m.x() + reach * dir.x(), s.p_m.y() + reach * dir.y(), s.p_m.z(),
+                    Eigen::Vector2f(-dir.y(), dir.x())))
+      return Reject::kCollision;
+  }
   // Tentative support must have been seen from above: some voxel over it (before anything
   // occupied) was crossed by a ray. The underside of a slab, seen only from below, has unknown
   // space over it until the floor above is observed.
@@ -228,7 +238,7 @@ Reject SupportQuery::classify_node(const Support& s, bool* confirmed) {
   for (int dx = -1; dx <= 1 && !seen; ++dx)
     for (int dy = -1; dy <= 1 && !seen; ++dy)
       seen = free(cell({s.key.x + dx, s.key.y + dy, s.key.z + 1}));
-  for (int dz = 2; dz <= 3 && !seen; ++dz) {
+  for (int dz = 2; dz <= 2 && !seen; ++dz) {
     const Cell* c = cell({s.key.x, s.key.y, s.key.z + dz});
     if (occupied(c)) break;
     seen = free(c);

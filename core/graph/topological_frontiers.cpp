@@ -140,22 +140,25 @@ void TopologicalFrontiers::evaluate(ReachableGraph& g, const map::MapView& view,
 
 FrontierUpdateStats TopologicalFrontiers::update(ReachableGraph& g, const map::MapView& view,
                                                  const Eigen::Vector3f& robot,
-                                                 std::span<const Aabb> changed) {
+                                                 std::span<const Aabb> changed,
+                                                 std::span<const Aabb> opened) {
   FrontierUpdateStats st;
   queued_.resize(g.node_capacity(), 0);
   std::vector<NodeId>& fresh = scratch_;
   fresh.clear();
   g.take_touched(fresh);
-  if (!changed.empty()) {
+  if (!changed.empty() || !opened.empty()) {
+    // C_exp probes reach probe_length_m, Omega_i reaches surface_radius_factor * r_e.
     const float reach =
         float(std::max(opt_.probe_length_m, opt_.surface_radius_factor * opt_.r_e_m));
     for (NodeId i = 0; i < g.node_capacity(); ++i) {
-      if (!g.node(i).alive) continue;
-      for (const Aabb& b : changed)
-        if (b.inflated(reach).contains(g.node(i).p_m)) {
-          fresh.push_back(i);
-          break;
-        }
+      const GraphNode& n = g.node(i);
+      if (!n.alive) continue;
+      bool in = false;
+      for (const Aabb& b : opened) in = in || b.inflated(reach).contains(n.p_m);
+      if (n.frontier())
+        for (const Aabb& b : changed) in = in || b.inflated(reach).contains(n.p_m);
+      if (in) fresh.push_back(i);
     }
   }
   std::stable_sort(fresh.begin(), fresh.end(), [&](NodeId a, NodeId b) {

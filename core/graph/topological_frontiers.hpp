@@ -34,8 +34,14 @@ class TopologicalFrontiers {
  public:
   explicit TopologicalFrontiers(const GraphOptions& opt = {});
 
+  // `changed`: regions that changed (frontier nodes near them are re-evaluated: unknown space
+  // only ever becomes known, so a non-frontier node stays one unless its edges change or
+  // something is removed); `opened`: regions that lost occupied voxels (every node near them
+  // is re-evaluated: a probe or a sample may see through now). Nodes the graph touched are
+  // always re-evaluated. Pass the same boxes twice when the kind of change is unknown.
   FrontierUpdateStats update(ReachableGraph& g, const map::MapView& view,
-                             const Eigen::Vector3f& robot_m, std::span<const Aabb> changed);
+                             const Eigen::Vector3f& robot_m, std::span<const Aabb> changed,
+                             std::span<const Aabb> opened);
   // Evaluates one node now (also used by tests): writes rho, open_dirs and the flags.
   void evaluate(ReachableGraph& g, const map::MapView& view, NodeId i);
   bool idle() const { return queue_.empty(); }

@@ -93,7 +93,7 @@ struct Harness {
     foot = foot_m;
     const core::graph::Aabb box = core::graph::scan_bounds(sensor, pts);
     last = graph.update(map.view(), foot, std::span(&box, 1), rng);
-    frontiers.update(graph, map.view(), foot, std::span(&box, 1));
+    frontiers.update(graph, map.view(), foot, std::span(&box, 1), std::span(&box, 1));
     for (int r = 0; r < int(core::graph::Reject::kCount); ++r) rejects[r] += last.rejects[r];
     settle();
     if (getenv("STOREY_DEBUG"))
@@ -111,7 +111,7 @@ struct Harness {
   void settle(int max_cycles = 200) {
     for (int i = 0; i < max_cycles && !(graph.idle() && frontiers.idle()); ++i) {
       const auto st = graph.update(map.view(), foot, {}, rng);
-      frontiers.update(graph, map.view(), foot, {});
+      frontiers.update(graph, map.view(), foot, {}, {});
       for (int r = 0; r < int(core::graph::Reject::kCount); ++r) rejects[r] += st.rejects[r];
       last.nodes_pruned += st.nodes_pruned;
       last.disconnected += st.disconnected;

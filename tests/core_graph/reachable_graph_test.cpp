@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "core/graph/map_change_detector.hpp"
 #include "core/graph/reachable_graph.hpp"
 #include "tests/core_graph/graph_world.hpp"
 
@@ -37,13 +38,15 @@ World two_floor_building() {
   return w;
 }
 
-// Top of the highest box within 0.1 m (one voxel) of (x, y) whose top is at most z_max: the
-// analytic support height, tolerant to the map's discretisation at box borders.
+// Top of the highest box within 0.15 m of (x, y) whose top is at most z_max: the analytic
+// support height, tolerant to the map's discretisation at box borders (0.1 m voxels, and the
+// graph may take a support from the neighbour column, SupportQuery::support_dilated).
 float support_height(const World& w, float x, float y, float z_max) {
   float best = -1e9f;
+  const float t = 0.15f;
   for (const auto& b : w.boxes)
-    if (x >= b.lo.x() - 0.1f && x <= b.hi.x() + 0.1f && y >= b.lo.y() - 0.1f &&
-        y <= b.hi.y() + 0.1f && b.hi.z() <= z_max)
+    if (x >= b.lo.x() - t && x <= b.hi.x() + t && y >= b.lo.y() - t && y <= b.hi.y() + t &&
+        b.hi.z() <= z_max)
       best = std::max(best, b.hi.z());
   return best;
 }
@@ -118,11 +121,20 @@ TEST(ReachableGraph, ConnectsFloorsThroughStairsNeverThroughSlab) {
   }
   EXPECT_GT(lower, 25);
   EXPECT_GT(upper, 25);
-  // Every edge is a walk over the analytic surface in steps no higher than a stair step.
+  // Every confirmed edge is a walk over the analytic surface in steps no higher than a stair
+  // step (tentative ones may cross up to max_gap_m of unknown ground by design); no edge of any
+  // state climbs more than half a metre except on the flight of stairs.
   for (EdgeId e = 0; e < g.edge_capacity(); ++e) {
     const GraphEdge& ge = g.edge(e);
     if (!ge.alive) continue;
     const Vector3f a = g.node(ge.a).p_m, b = g.node(ge.b).p_m;
+    if (std::abs(a.z() - b.z()) > 0.5f) {
+      for (const Vector3f& p : {a, b}) {
+        EXPECT_TRUE(p.x() > -2.2f && p.x() < 3.2f && p.y() > 2.5f)
+            << "edge " << e << " climbs off the stairs at " << p.transpose();
+      }
+    }
+    if (ge.state != ElementState::kConfirmed) continue;
     float z = a.z();
     for (int k = 1; k <= 40; ++k) {
       const Vector3f p = a + (b - a) * (float(k) / 40.f);
@@ -300,4 +312,39 @@ TEST(ReachableGraph, CuttingTheCorridorRemovesTheFarComponent) {
   EXPECT_GT(s.count(-2.0f, 4.5f), 8);
   EXPECT_LT(s.h.graph.node_count(), before);
   EXPECT_GT(s.h.last.disconnected, 0u);
+}
+
+TEST(MapChangeDetector, ReportsWhereTheMapChangedAndWhatWasRemoved) {
+  World w = corridor();
+  storey::core::map::TraversabilityMap m;
+  MapChangeDetector d;
+  std::vector<Aabb> changed, opened;
+  auto scan = [&](uint32_t seed) {
+    const Vector3f o(3, 0, 0.55f);
+    const auto pts = storey::test::graph::scan(w, o, 100000, seed, 5.0f);
+    m.insert_scan(o, pts);
+    m.update_traversability();
+    m.update_reachable(Vector3f(3, 0, 0));
+    const Aabb box = scan_bounds(o, pts);
+    changed.clear();
+    opened.clear();
+    return d.detect(m.view(), std::span(&box, 1), changed, &opened);
+  };
+  EXPECT_GT(scan(1), 0u);  // first sight: everything is new
+  // (Re-observing a static scene still flips some blocks: surface voxels alternate between
+  // free and occupied under grazing rays; PERFORMANCE.md gives the per-cycle counts.)
+  for (uint32_t s = 2; s < 7; ++s) scan(s);
+  // A box appears at x = 5: the change is reported there, and nothing was removed.
+  w.add({4.8f, -0.2f, 0.0f}, {5.2f, 0.2f, 0.8f});
+  scan(7);
+  bool covers = false;
+  for (const Aabb& b : changed) covers |= b.inflated(0.2f).contains(Vector3f(5, 0, 0.4f));
+  EXPECT_TRUE(covers) << "the new box is not inside a changed region";
+  w.boxes.pop_back();  // ... and leaves again: its blocks lose occupied voxels.
+  bool opened_there = false;
+  for (uint32_t s = 9; s < 13 && !opened_there; ++s) {
+    scan(s);
+    for (const Aabb& b : opened) opened_there |= b.inflated(0.2f).contains(Vector3f(5, 0, 0.4f));
+  }
+  EXPECT_TRUE(opened_there) << "the removal is not reported as an opening";
 }

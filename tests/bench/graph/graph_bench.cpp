@@ -121,12 +121,12 @@ struct Building {
       }
     for (int i = 0; i < 200 && !(graph->idle() && frontiers->idle()); ++i) {
       graph->update(map.view(), foot, {}, rng);
-      frontiers->update(*graph, map.view(), foot, {});
+      frontiers->update(*graph, map.view(), foot, {}, {});
     }
     graph->touch_all();
     for (int i = 0; i < 200 && !(graph->idle() && frontiers->idle()); ++i) {
       graph->update(map.view(), foot, {}, rng);
-      frontiers->update(*graph, map.view(), foot, {});
+      frontiers->update(*graph, map.view(), foot, {}, {});
     }
     clusters->update(*graph);
   }
@@ -161,10 +161,10 @@ void add_box_faces(std::vector<Vector3f>& pts, const Vector3f& lo, const Vector3
 void BM_CycleMovingObstacle(benchmark::State& state) {
   Building& b = building();
   graph::MapChangeDetector detector;
-  std::vector<graph::Aabb> changed;
+  std::vector<graph::Aabb> changed, opened;
   std::vector<Vector3f> pts;
   std::vector<double> ms;
-  double changed_blocks = 0;
+  double changed_blocks = 0, revalidated = 0, expanded = 0, evaluated = 0, boxes = 0;
   graph::FrontierUpdateStats fs_last;
   int step = 0;
   const float y = 3 * kRoom + kRoom / 2;
@@ -196,11 +196,17 @@ void BM_CycleMovingObstacle(benchmark::State& state) {
     b.map.update_reachable(b.foot);
     const graph::Aabb bounds = graph::scan_bounds(origin, pts);
     changed.clear();
+    opened.clear();
     state.ResumeTiming();
     const auto t0 = std::chrono::steady_clock::now();
-    changed_blocks += double(detector.detect(b.map.view(), std::span(&bounds, 1), changed));
-    b.graph->update(b.map.view(), b.foot, changed, b.rng);
-    fs_last = b.frontiers->update(*b.graph, b.map.view(), b.foot, changed);
+    changed_blocks +=
+        double(detector.detect(b.map.view(), std::span(&bounds, 1), changed, &opened));
+    const auto gs = b.graph->update(b.map.view(), b.foot, changed, b.rng);
+    fs_last = b.frontiers->update(*b.graph, b.map.view(), b.foot, changed, opened);
+    revalidated += gs.revalidated;
+    expanded += gs.expanded;
+    evaluated += fs_last.evaluated;
+    boxes += double(changed.size());
     const auto& cl = b.clusters->update(*b.graph);
     const auto t1 = std::chrono::steady_clock::now();
     benchmark::DoNotOptimize(cl.data());
@@ -211,7 +217,12 @@ void BM_CycleMovingObstacle(benchmark::State& state) {
   state.counters["edges"] = double(b.graph->edge_count());
   state.counters["frontiers"] = double(fs_last.frontiers);
   state.counters["clusters"] = double(b.clusters->clusters().size());
-  state.counters["changed_blocks"] = changed_blocks / double(std::max<size_t>(1, ms.size()));
+  const double n = double(std::max<size_t>(1, ms.size()));
+  state.counters["changed_blocks"] = changed_blocks / n;
+  state.counters["changed_boxes"] = boxes / n;
+  state.counters["revalidated"] = revalidated / n;
+  state.counters["expanded"] = expanded / n;
+  state.counters["tf_evaluated"] = evaluated / n;
   state.SetItemsProcessed(int64_t(state.iterations()));
 }
 BENCHMARK(BM_CycleMovingObstacle)
@@ -237,7 +248,8 @@ void BM_GraphCycleRegion(benchmark::State& state) {
     changed.extend(b.foot + Vector3f(half, half, kHeight));
     const auto t0 = std::chrono::steady_clock::now();
     b.graph->update(b.map.view(), b.foot, std::span(&changed, 1), b.rng);
-    fs_last = b.frontiers->update(*b.graph, b.map.view(), b.foot, std::span(&changed, 1));
+    fs_last = b.frontiers->update(*b.graph, b.map.view(), b.foot, std::span(&changed, 1),
+                                  std::span(&changed, 1));
     const auto& cl = b.clusters->update(*b.graph);
     const auto t1 = std::chrono::steady_clock::now();
     benchmark::DoNotOptimize(cl.data());
