@@ -36,10 +36,10 @@ struct GraphOptions {
   double root_radius_m = 1.0;         // the robot's node: nearest within this, else a new one
   double floor_height_hint_m = 3.0;   // floor id hint = round(z / this) (planning refines floors)
   // --- incremental update budgets (bounded work per map cycle) ---
-  // (~23 us per operation at 0.1 m voxels: these bound a cycle to ~7 ms CPU; PERFORMANCE.md)
-  int max_expansions_per_update = 60;      // nodes expanded per update (queue carries over)
-  int max_revalidations_per_update = 120;  // nodes (with their edges) re-checked per update
-  int max_frontier_updates = 120;          // nodes whose frontier flags are recomputed per update
+  // (~23 us per operation at 0.1 m voxels: these bound a cycle to ~5 ms CPU; PERFORMANCE.md)
+  int max_expansions_per_update = 40;     // nodes expanded per update (queue carries over)
+  int max_revalidations_per_update = 80;  // nodes (with their edges) re-checked per update
+  int max_frontier_updates = 80;          // nodes whose frontier flags are recomputed per update
   // --- frontiers (Sec. III-C) ---
   int surface_samples = 32;        // |Omega_i|: samples of the disc, Eq. 5
   double probe_height_m = 0.3;     // C_exp probes run this far above the node's support

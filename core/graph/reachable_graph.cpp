@@ -428,17 +428,17 @@ GraphUpdateStats ReachableGraph::update(const map::MapView& view, const Eigen::V
   // 1. The affected subgraph: nodes in the changed regions inflated by the reach of their
   //    edges and expansion candidates, nearest to the robot first.
   const float reach = float(opt_.neighbour_radius_factor * opt_.r_e_m);
+  boxes_.clear();
+  for (const Aabb& b : changed)
+    if (!b.empty()) boxes_.push_back(b.inflated(reach));
   scratch_.clear();
   for (NodeId i = 0; i < nodes_.size(); ++i) {
     const GraphNode& n = nodes_[i];
     if (!n.alive || (n.queued & GraphNode::kQueuedRevalidate)) continue;
     bool in = false;
-    for (const Aabb& b : changed) in = in || b.inflated(reach).contains(n.p_m);
+    for (const Aabb& b : boxes_) in = in || b.contains(n.p_m);
     // Promotion / demotion: C_reach can grow or shrink far from the scan (region growing).
-    if (!in) {
-      const bool reach = view.is_reachable(n.key);
-      in = reach != (n.state == ElementState::kConfirmed);
-    }
+    if (!in) in = q.reachable(n.key) != (n.state == ElementState::kConfirmed);
     if (in) scratch_.push_back(i);
   }
   std::stable_sort(scratch_.begin(), scratch_.end(), [&](NodeId a, NodeId b) {

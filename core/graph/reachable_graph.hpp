@@ -168,6 +168,7 @@ class ReachableGraph {
   std::unordered_map<uint64_t, std::vector<NodeId>> grid_;
   // Scratch (reused; no allocation in steady state once grown).
   std::vector<NodeId> scratch_, bfs_;
+  std::vector<Aabb> boxes_;
   std::vector<uint32_t> mark_;
   uint32_t mark_epoch_ = 0;
   uint32_t cycle_ = 0;

@@ -52,6 +52,10 @@ class SupportQuery {
   SupportQuery(const map::MapView& view, const GraphOptions& opt);
 
   map::Occupancy occupancy(const map::VoxelKey& k);
+  bool reachable(const map::VoxelKey& k) {  // v in C_reach
+    const map::Cell* c = cell(k);
+    return c && (c->flags & map::Cell::kReachable);
+  }
   // The support voxel in the column under (x, y) whose surface height is closest to z, within
   // +-window_m; nullopt if none.
   std::optional<Support> surface_near(float x, float y, float z, float window_m);

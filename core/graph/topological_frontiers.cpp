@@ -151,13 +151,19 @@ FrontierUpdateStats TopologicalFrontiers::update(ReachableGraph& g, const map::M
     // C_exp probes reach probe_length_m, Omega_i reaches surface_radius_factor * r_e.
     const float reach =
         float(std::max(opt_.probe_length_m, opt_.surface_radius_factor * opt_.r_e_m));
+    boxes_.clear();
+    opened_.clear();
+    for (const Aabb& b : changed)
+      if (!b.empty()) boxes_.push_back(b.inflated(reach));
+    for (const Aabb& b : opened)
+      if (!b.empty()) opened_.push_back(b.inflated(reach));
     for (NodeId i = 0; i < g.node_capacity(); ++i) {
       const GraphNode& n = g.node(i);
       if (!n.alive) continue;
       bool in = false;
-      for (const Aabb& b : opened) in = in || b.inflated(reach).contains(n.p_m);
+      for (const Aabb& b : opened_) in = in || b.contains(n.p_m);
       if (n.frontier())
-        for (const Aabb& b : changed) in = in || b.inflated(reach).contains(n.p_m);
+        for (const Aabb& b : boxes_) in = in || b.contains(n.p_m);
       if (in) fresh.push_back(i);
     }
   }

@@ -59,6 +59,7 @@ class TopologicalFrontiers {
   std::vector<uint8_t> queued_;
   std::vector<NodeId> scratch_;
   std::vector<uint8_t> cls_;
+  std::vector<Aabb> boxes_, opened_;
 };
 
 }  // namespace storey::core::graph
