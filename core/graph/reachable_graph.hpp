@@ -109,6 +109,11 @@ class ReachableGraph {
                           std::span<const Aabb> changed, std::mt19937_64& rng);
   // Queues every node for revalidation and expansion (e.g. after the options changed).
   void touch_all();
+  // Per-update work limits (see GraphOptions::max_*_per_update).
+  void set_budgets(int revalidations, int expansions, int /*reserved*/) {
+    opt_.max_revalidations_per_update = revalidations;
+    opt_.max_expansions_per_update = expansions;
+  }
   // Queues one node for expansion at the next update (a new topological frontier).
   void request_expand(NodeId i) {
     if (i < nodes_.size() && nodes_[i].alive) queue_expand(i);

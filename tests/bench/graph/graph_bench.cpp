@@ -296,6 +296,37 @@ BENCHMARK(BM_GraphCycleRegion)
     ->Unit(benchmark::kMillisecond)
     ->Iterations(100);
 
+// Baseline for the incremental update: every node revalidated (with its edges) and every
+// node's frontier flags recomputed, as a from-scratch pass over the converged graph would.
+void BM_GraphFullPass(benchmark::State& state) {
+  Building& b = building();
+  graph::GraphOptions all = b.opt;
+  all.max_revalidations_per_update = 1 << 30;
+  all.max_expansions_per_update = 0;
+  graph::ReachableGraph& g = *b.graph;
+  Samples ms;
+  for (auto _ : state) {
+    state.PauseTiming();
+    graph::ReachableGraph copy = g;  // keep the shared graph untouched
+    copy.touch_all();
+    graph::TopologicalFrontiers tf(all);
+    graph::FrontierClusters fc(all);
+    state.ResumeTiming();
+    ms.start();
+    graph::GraphOptions o = all;
+    copy.set_budgets(o.max_revalidations_per_update, 0, 0);
+    copy.update(b.map.view(), b.foot, {}, b.rng);
+    for (graph::NodeId i = 0; i < copy.node_capacity(); ++i)
+      if (copy.node(i).alive) tf.evaluate(copy, b.map.view(), i);
+    benchmark::DoNotOptimize(fc.update(copy).data());
+    ms.stop();
+  }
+  report(state, ms);
+  state.counters["nodes"] = double(g.node_count());
+  state.SetItemsProcessed(int64_t(state.iterations()));
+}
+BENCHMARK(BM_GraphFullPass)->Name("graph/full_pass")->Unit(benchmark::kMillisecond)->Iterations(5);
+
 // Viewpoint scoring (ray casting with the FOV and occlusion), per cluster.
 void BM_ViewpointsPerCluster(benchmark::State& state) {
   Building& b = building();
