@@ -42,6 +42,11 @@ class TopologicalFrontiers {
   FrontierUpdateStats update(ReachableGraph& g, const map::MapView& view,
                              const Eigen::Vector3f& robot_m, std::span<const Aabb> changed,
                              std::span<const Aabb> opened);
+  // Kind of change unknown (e.g. plain scan bounds): every node near `changed` is re-evaluated.
+  FrontierUpdateStats update(ReachableGraph& g, const map::MapView& view,
+                             const Eigen::Vector3f& robot_m, std::span<const Aabb> changed) {
+    return update(g, view, robot_m, changed, changed);
+  }
   // Evaluates one node now (also used by tests): writes rho, open_dirs and the flags.
   void evaluate(ReachableGraph& g, const map::MapView& view, NodeId i);
   bool idle() const { return queue_.empty(); }
