@@ -8,6 +8,8 @@ std::span<const Command> commands() {
        cmd_check_config},
       {"replay", "recorded LiDAR packets (pcap, pcapng, .lvx2) through ingestion and scan assembly",
        cmd_replay},
+      {"run", "live exploration: LiDAR over UDP, the robot's link, real-time task threads",
+       cmd_run},
       {"self-check", "quick check of this build: clocks, scheduler, queues, default config",
        cmd_self_check},
 #ifdef STOREY_HAVE_SIM

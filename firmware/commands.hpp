@@ -18,6 +18,7 @@ std::span<const Command> commands();
 int cmd_self_check(int argc, char** argv);
 int cmd_check_config(int argc, char** argv);
 int cmd_replay(int argc, char** argv);
+int cmd_run(int argc, char** argv);
 // Defined in tools/sim/sim_command.cpp (linked only when the tools are built).
 int cmd_sim(int argc, char** argv);
 
