@@ -125,6 +125,7 @@ void read_graph(SectionReader&& r, core::graph::GraphOptions& o) {
   r.get("max_frontier_updates", o.max_frontier_updates, Range{1, 10000000});
   r.get("surface_samples", o.surface_samples, Range{1, 4096});
   r.get("probe_height_m", o.probe_height_m, Range{0.0, 3.0});
+  r.get("probe_unknown_m", o.probe_unknown_m, Range{0.0, 10.0});
   r.get("boundary_radius_m", o.boundary_radius_m, Range{0.01, 10.0});
   r.get("viewpoint_target_height_m", o.viewpoint_target_height_m, Range{0.0, 3.0});
 }
