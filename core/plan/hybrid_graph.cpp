@@ -283,10 +283,13 @@ void HybridGraph::compile(const map::MapView& view, const graph::ReachableGraph&
       const float da = (g.node(a).p_m - p).squaredNorm(), db = (g.node(b).p_m - p).squaredNorm();
       return da < db || (da == db && a < b);
     });
-    int added = 0;
+    // At most the 3 nearest candidates are checked (bounded work: the obstacle walks are the
+    // cost of this loop), at most 2 bridges kept.
+    int added = 0, tried = 0;
     for (NodeId r : near_) {
       const uint32_t v = real_index_[r];
       if (v == kNoNode || !nodes_[v].on_target) continue;
+      if (++tried > 3) break;
       if (segment_blocked(view, nodes_[u].p_m, nodes_[v].p_m)) continue;
       edges_.push_back({v, u, ElementState::kHypothetical});
       if (++added == 2) break;

@@ -136,6 +136,6 @@ void BM_PlanMacroCycle(benchmark::State& st) {
   st.counters["clusters"] = double(s.h.clusters.clusters().size());
   st.counters["new_traj_frac"] = double(new_traj) / double(ms.size());
 }
-BENCHMARK(BM_PlanMacroCycle)->Unit(benchmark::kMillisecond)->Iterations(100);
+BENCHMARK(BM_PlanMacroCycle)->Unit(benchmark::kMillisecond)->Iterations(30);
 
 }  // namespace
