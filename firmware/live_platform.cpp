@@ -1,7 +1,6 @@
 #include "firmware/live_platform.hpp"
 
 #include <arpa/inet.h>
-#include <dirent.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
 #include <time.h>
@@ -21,37 +20,6 @@ std::int64_t clock_ns(clockid_t id) {
   timespec ts;
   clock_gettime(id, &ts);
   return std::int64_t(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
-
-// The receiver's UDP socket, for the scheduler's epoll set. UdpReceiver does not expose its fd,
-// so it is found by what it is: the process's datagram socket bound to the receiver's port.
-// (A one-line `int fd() const` on UdpReceiver would make this lookup unnecessary; it is used
-// when present.)
-template <typename R>
-int receiver_fd(const R& r, uint16_t port) {
-  if constexpr (requires { r.fd(); }) {
-    return r.fd();
-  } else {
-    DIR* d = opendir("/proc/self/fd");
-    if (!d) return -1;
-    int found = -1;
-    while (dirent* e = readdir(d)) {
-      char* end = nullptr;
-      const long fd = std::strtol(e->d_name, &end, 10);
-      if (end == e->d_name || *end != '\0') continue;
-      int type = 0;
-      socklen_t tl = sizeof type;
-      if (getsockopt(int(fd), SOL_SOCKET, SO_TYPE, &type, &tl) != 0 || type != SOCK_DGRAM) continue;
-      sockaddr_in a{};
-      socklen_t al = sizeof a;
-      if (getsockname(int(fd), reinterpret_cast<sockaddr*>(&a), &al) != 0 ||
-          a.sin_family != AF_INET || ntohs(a.sin_port) != port)
-        continue;
-      found = int(fd);
-    }
-    closedir(d);
-    return found;
-  }
 }
 
 lidar::RigidTransform to_rigid(const Eigen::Quaterniond& q, const Eigen::Vector3d& t) {
@@ -205,7 +173,7 @@ LivePlatform::~LivePlatform() {
 lidar::UdpReceiver::OpenStatus LivePlatform::open() {
   lidar::UdpReceiver::OpenStatus st = receiver_->open();
   if (!st.ok) return st;
-  lidar_fd_ = receiver_fd(*receiver_, receiver_->bound_port());
+  lidar_fd_ = receiver_->fd();
   if (lidar_fd_ < 0) {
     st.ok = false;
     st.error = "lidar: cannot find the socket of port " + std::to_string(receiver_->bound_port());

@@ -79,6 +79,8 @@ class UdpReceiver {
   OpenStatus open();
   void close();
   uint16_t bound_port() const { return bound_port_; }
+  // The UDP socket (-1 before open()): the firmware's event-driven ingest task waits on it.
+  int fd() const { return fd_; }
 
   // Optional taps, set before the ingest thread starts.
   void set_imu_queue(rt::SpscQueue<ImuSample>* q) { imu_out_ = q; }
