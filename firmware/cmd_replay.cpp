@@ -14,6 +14,9 @@
 #include <thread>
 #include <vector>
 
+#include <Eigen/Geometry>
+
+#include "config/parameters.hpp"
 #include "drivers/lidar/mid360.hpp"
 #include "drivers/lidar/scan_assembler.hpp"
 #include "drivers/lidar/scan_csv.hpp"
@@ -21,7 +24,9 @@
 #include "drivers/lidar/vlp16.hpp"
 #include "drivers/pcap/lvx2_reader.hpp"
 #include "drivers/pcap/pcap_reader.hpp"
+#include "firmware/autonomy.hpp"
 #include "firmware/commands.hpp"
+#include "firmware/replay_platform.hpp"
 #include "rt/clock.hpp"
 #include "rt/latency_stats.hpp"
 #include "rt/spsc_queue.hpp"
@@ -38,18 +43,24 @@ void print_help(FILE* out) {
   std::fprintf(
       out,
       "usage: storey replay FILE [--sensor vlp16|mid360] [--rate X | --fast] [--profile]\n"
-      "                    [--out DIR] [--export-scans DIR]\n\n"
-      "Drives LiDAR ingestion and scan assembly from recorded packets: pcap or pcapng (tcpdump,\n"
-      "Wireshark; Ethernet, VLAN, Linux cooked SLL/SLL2, raw IP) or a Livox Viewer 2 .lvx2.\n\n"
+      "                    [--out DIR] [--export-scans DIR] [--config FILE] [--no-map]\n\n"
+      "Drives LiDAR ingestion, scan assembly, and the firmware's map and graph tasks from\n"
+      "recorded packets: pcap or pcapng (tcpdump, Wireshark; Ethernet, VLAN, Linux cooked\n"
+      "SLL/SLL2, raw IP) or a Livox Viewer 2 .lvx2. A LiDAR capture holds no odometry: the\n"
+      "robot is taken to stand still at the origin, the sensor at the configured mounting.\n\n"
       "  --sensor S         vlp16 (default; .lvx2 files default to mid360)\n"
       "  --rate X           replay at X times the recorded timing (default 1)\n"
       "  --fast             as fast as possible\n"
-      "  --profile          print per-stage latency and write DIR/trace.json\n"
+      "  --profile          print per-stage and per-task latency; write DIR/trace.json (tasks)\n"
+      "                     and DIR/trace_ingest.json (per-packet decode and assembly)\n"
+      "  --config FILE      parameters (default config/default.yaml)\n"
+      "  --no-map           ingestion and scan assembly only\n"
       "  --out DIR          output folder (default out/replay)\n"
       "  --export-scans D   each assembled scan as D/scan_NNNNNN.csv (sensor frame: x,y,z,\n"
       "                     intensity,ring,time_offset_ns; packet order; no-return points left "
       "out)\n\n"
-      "writes DIR/replay.json: packets, points, scans and drops by reason.\n");
+      "writes DIR/replay.json: packets, points, scans, drops by reason, and the map and graph\n"
+      "they built (volumes, nodes, frontiers).\n");
 }
 
 std::string json_escape(const std::string& s) {
@@ -70,8 +81,10 @@ bool ends_with(const std::string& s, const char* suffix) {
 // Counts scans and writes them out when asked (file I/O: this is a non-RT command).
 class ReplaySink final : public lidar::ScanSink {
  public:
-  explicit ReplaySink(std::string export_dir) : dir_(std::move(export_dir)) {}
+  ReplaySink(std::string export_dir, lidar::ScanSink* next)
+      : dir_(std::move(export_dir)), next_(next) {}
   void on_scan(const lidar::Scan& scan) override {
+    if (next_ != nullptr) next_->on_scan(scan);
     ++scans_;
     points_ += scan.points.size();
     if (!dir_.empty() && error_.empty()) {
@@ -85,6 +98,7 @@ class ReplaySink final : public lidar::ScanSink {
 
  private:
   std::string dir_, error_;
+  lidar::ScanSink* next_;
   std::uint64_t scans_ = 0, points_ = 0;
 };
 
@@ -97,9 +111,9 @@ struct Stage {
 
 int cmd_replay(int argc, char** argv) {
   std::string file, out_dir = "out/replay", export_dir;
-  std::string sensor_name;
+  std::string sensor_name, config_path;
   double rate = 1.0;
-  bool fast = false, profile = false;
+  bool fast = false, profile = false, with_map = true;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto value = [&](const char* flag) -> const char* {
@@ -129,6 +143,12 @@ int cmd_replay(int argc, char** argv) {
       fast = true;
     } else if (a == "--profile") {
       profile = true;
+    } else if (a == "--no-map") {
+      with_map = false;
+    } else if (a == "--config") {
+      const char* v = value("--config");
+      if (!v) return 2;
+      config_path = v;
     } else if (a == "--out") {
       const char* v = value("--out");
       if (!v) return 2;
@@ -175,6 +195,48 @@ int cmd_replay(int argc, char** argv) {
     }
   }
 
+  // The firmware's parameters: the mounting places the sensor, the task table runs map + graph.
+  if (config_path.empty()) config_path = default_config_path();
+  const config::Result cfg = config::load(config_path);
+  if (!cfg.ok()) {
+    for (const auto& e : cfg.errors) std::fprintf(stderr, "%s\n", e.to_string().c_str());
+    std::fprintf(stderr, "storey replay: invalid configuration %s\n", config_path.c_str());
+    return 2;
+  }
+  const config::SensorConfig& sc = cfg.params.sensor;
+  const Eigen::Quaterniond q_mount =
+      Eigen::AngleAxisd(sc.mounting_rpy_rad[2], Eigen::Vector3d::UnitZ()) *
+      Eigen::AngleAxisd(sc.mounting_rpy_rad[1], Eigen::Vector3d::UnitY()) *
+      Eigen::AngleAxisd(sc.mounting_rpy_rad[0], Eigen::Vector3d::UnitX());
+  lidar::RigidTransform sensor_in_world;
+  sensor_in_world.qw = float(q_mount.w()), sensor_in_world.qx = float(q_mount.x());
+  sensor_in_world.qy = float(q_mount.y()), sensor_in_world.qz = float(q_mount.z());
+  sensor_in_world.tx = float(sc.mounting_xyz_m[0]);
+  sensor_in_world.ty = float(sc.mounting_xyz_m[1]);
+  sensor_in_world.tz = float(sc.mounting_xyz_m[2] + kBodyCentreHeightM);
+  ReplayPlatform platform(sensor_in_world, Eigen::Vector3d::Zero());
+  rt::VirtualClock virtual_clock;
+  std::unique_ptr<Autonomy> autonomy;
+  std::uint64_t autonomy_log_lines = 0;
+  if (with_map) {
+    AutonomyOptions ao;
+    ao.params = cfg.params;
+    ao.fov = mid360 ? core::graph::SensorFov::mid360() : core::graph::SensorFov::vlp16();
+    ao.stop_on_overruns = false;  // lockstep on the capture's timeline
+    ao.log = [&autonomy_log_lines](const std::string&) { ++autonomy_log_lines; };
+    autonomy = std::make_unique<Autonomy>(platform, virtual_clock, ao);
+    autonomy->suspend_task("plan", true);  // nobody to command: map and graph only
+  }
+  std::int64_t first_sensor_ns = -1;
+  auto advance_firmware = [&](std::uint64_t capture_ns) {
+    if (!autonomy) return;
+    if (first_sensor_ns < 0) first_sensor_ns = static_cast<std::int64_t>(capture_ns);
+    const std::int64_t t = static_cast<std::int64_t>(capture_ns) - first_sensor_ns;
+    if (t <= virtual_clock.now_ns()) return;
+    platform.set_time(double(t) * 1e-9);
+    autonomy->run_until(virtual_clock, t);
+  };
+
   // The live path: receiver (not opened: no socket) -> SPSC queue -> assembler.
   rt::SpscQueue<lidar::PointChunk> queue(64);
   lidar::UdpReceiver::Options ropt;
@@ -182,7 +244,7 @@ int cmd_replay(int argc, char** argv) {
   ropt.port = mid360 ? lidar::kMid360HostPointPort : lidar::kVlp16DataPort;
   ropt.verify_crc = !is_lvx2;  // .lvx2 keeps no CRC
   auto receiver = std::make_unique<lidar::UdpReceiver>(ropt, queue);
-  ReplaySink sink(export_dir);
+  ReplaySink sink(export_dir, with_map ? &platform : nullptr);
   lidar::ScanAssembler::Options aopt;
   aopt.mode =
       mid360 ? lidar::ScanAssembler::Mode::time_window : lidar::ScanAssembler::Mode::rotation;
@@ -225,6 +287,7 @@ int cmd_replay(int argc, char** argv) {
     decode.hist.record(t1 - t0);
     if (profile) trace.record("decode", 1, t0, t1 - t0);
     drain();
+    advance_firmware(t_ns);
   };
 
   std::string input_error;
@@ -280,6 +343,10 @@ int cmd_replay(int argc, char** argv) {
     input_error = reader.error();
   }
   assembler.flush();
+  if (autonomy) {  // let the map task take the last sweeps (a few map periods)
+    platform.set_time(double(virtual_clock.now_ns() + 500'000'000) * 1e-9);
+    autonomy->run_until(virtual_clock, virtual_clock.now_ns() + 500'000'000);
+  }
   if (!sink.error().empty()) {
     std::fprintf(stderr, "storey replay: %s\n", sink.error().c_str());
     return 1;
@@ -312,7 +379,19 @@ int cmd_replay(int argc, char** argv) {
      << ", \"truncated\": " << frame_stats.truncated << ", \"malformed\": " << frame_stats.malformed
      << ", \"ip_length_mismatch\": " << frame_stats.ip_length_mismatch
      << ", \"other_port\": " << other_port << "},\n"
-     << "  \"input_error\": \"" << json_escape(input_error) << "\"\n}\n";
+     << "  \"input_error\": \"" << json_escape(input_error) << "\"";
+  if (autonomy) {
+    const auto w = autonomy->world();
+    const core::map::TraversabilityMap& m = autonomy->map_for_record();
+    js << ",\n  \"map\": {\"scans_inserted\": " << (w ? w->scans : 0)
+       << ", \"occupied_volume_m3\": " << m.occupied_volume_m3()
+       << ", \"traversable_volume_m3\": " << m.traversable_volume_m3()
+       << ", \"graph_nodes\": " << (w ? w->graph.node_count() : 0)
+       << ", \"graph_edges\": " << (w ? w->graph.edge_count() : 0)
+       << ", \"frontier_nodes\": " << (w ? w->frontier_nodes : 0)
+       << ", \"clusters\": " << (w ? w->clusters.size() : 0) << "}";
+  }
+  js << "\n}\n";
   js.close();
   if (!js) {
     std::fprintf(stderr, "storey replay: cannot write %s\n", json_path.c_str());
@@ -335,11 +414,18 @@ int cmd_replay(int argc, char** argv) {
                   q.p999_ns / 1e3, q.max_ns / 1e3);
     }
     std::string err;
-    if (!trace.write_chrome_json(out_dir + "/trace.json", &err)) {
+    if (!trace.write_chrome_json(out_dir + "/trace_ingest.json", &err) ||
+        (autonomy && !autonomy->trace().write_chrome_json(out_dir + "/trace.json", &err))) {
       std::fprintf(stderr, "storey replay: %s\n", err.c_str());
       return 1;
     }
-    std::printf("trace: %s/trace.json\n", out_dir.c_str());
+    if (autonomy) {
+      std::printf("%s", autonomy->scheduler().report().c_str());
+      std::printf("trace: %s/trace.json (tasks), %s/trace_ingest.json (packets)\n", out_dir.c_str(),
+                  out_dir.c_str());
+    } else {
+      std::printf("trace: %s/trace_ingest.json\n", out_dir.c_str());
+    }
   }
   std::printf("wrote %s\n", json_path.c_str());
   return input_error.empty() ? 0 : 1;

@@ -17,10 +17,6 @@
 #include "rt/spsc_queue.hpp"
 #include "rt/trace.hpp"
 
-#ifndef STOREY_CONFIG_DIR
-#define STOREY_CONFIG_DIR "config"
-#endif
-
 namespace storey::firmware {
 
 namespace {
@@ -30,11 +26,6 @@ int failures = 0;
 void check(bool ok, const char* what, const std::string& detail) {
   std::printf("  [%s] %-36s %s\n", ok ? " ok " : "FAIL", what, detail.c_str());
   if (!ok) ++failures;
-}
-
-std::string default_config_path() {
-  if (std::filesystem::exists("config/default.yaml")) return "config/default.yaml";
-  return std::string(STOREY_CONFIG_DIR) + "/default.yaml";
 }
 
 // Runs the configured task table in lockstep for `seconds` of virtual time and returns the

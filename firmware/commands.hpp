@@ -2,6 +2,7 @@
 // The verbs of the storey executable. Each returns a process exit code: 0 success,
 // 1 the work failed, 2 bad usage or bad input (with a one-line reason on stderr).
 #include <span>
+#include <string>
 
 namespace storey::firmware {
 
@@ -14,6 +15,9 @@ struct Command {
 };
 
 std::span<const Command> commands();
+
+// config/default.yaml from the working directory if there, else from the source tree.
+std::string default_config_path();
 
 int cmd_self_check(int argc, char** argv);
 int cmd_check_config(int argc, char** argv);

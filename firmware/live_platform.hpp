@@ -36,8 +36,9 @@ struct LivePlatformOptions {
   config::Parameters params;
   std::size_t chunk_queue = 512;  // decoded packets in flight (~0.7 s of VLP-16, 0.25 s Mid-360)
   std::size_t record_queue = 0;   // > 0: raw datagrams tapped for `--record` (drain_record)
-  double max_extrapolation_s = 0.15;    // newest LiDAR points may be this far past the last state
-  double default_body_height_m = 0.32;  // Go2 body centre above the feet when not reported
+  double max_extrapolation_s = 0.15;  // newest LiDAR points may be this far past the last state
+  double default_body_height_m =
+      kBodyCentreHeightM;  // Go2 body centre above the feet when not reported
   // Receive port override (tests: 0 = ephemeral); < 0 = params.sensor.data_port.
   int data_port = -1;
 };

@@ -11,6 +11,10 @@
 
 namespace storey::firmware {
 
+// The Go2's body centre stands this far above its feet; the robot reports the centre's position
+// and the sensor mounting is given relative to it.
+inline constexpr double kBodyCentreHeightM = 0.32;
+
 // One sweep in the world (odometry) frame, deskewed by the platform. A pool buffer: its vectors
 // keep their capacity between sweeps, so steady-state ingestion does not allocate.
 struct ScanBuffer {

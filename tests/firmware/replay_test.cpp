@@ -38,6 +38,12 @@ TEST(Replay, RealVlp16CaptureWritesCountsAndScans) {
   EXPECT_NE(json.find("\"position_packets\": 16,"), std::string::npos) << json;
   EXPECT_NE(json.find("\"dropped\": 0,"), std::string::npos) << json;
   EXPECT_TRUE(fs::exists(out / "trace.json"));
+  EXPECT_TRUE(fs::exists(out / "trace_ingest.json"));
+  // The firmware's map and graph tasks ran on the sweeps: both scans went into the map, which
+  // then holds a traversable surface (the capture's ground) and a graph on it.
+  EXPECT_NE(json.find("\"map\": {\"scans_inserted\": 2,"), std::string::npos) << json;
+  EXPECT_EQ(json.find("\"traversable_volume_m3\": 0,"), std::string::npos) << json;
+  EXPECT_EQ(json.find("\"graph_nodes\": 0,"), std::string::npos) << json;
   // Every exported point is a line of its scan's CSV; their sum is the decoded point count.
   std::size_t lines = 0, files = 0;
   for (const auto& e : fs::directory_iterator(out / "scans")) {
@@ -54,11 +60,20 @@ TEST(Replay, RealVlp16CaptureWritesCountsAndScans) {
   EXPECT_EQ(std::to_string(lines), json.substr(at + 10, json.find(',', at) - at - 10));
 }
 
+TEST(Replay, NoMapSkipsTheFirmwareTasks) {
+  const fs::path out = fs::temp_directory_path() / "storey_replay_nomap";
+  fs::remove_all(out);
+  const std::string capture = std::string(STOREY_SOURCE_DIR) + "/tests/data/velodyne_vlp16.pcap";
+  ASSERT_EQ(run({"replay", capture, "--fast", "--no-map", "--out", out.string()}), 0);
+  EXPECT_EQ(slurp(out / "replay.json").find("\"map\""), std::string::npos);
+}
+
 TEST(Replay, BadInputIsAOneLineErrorNotACrash) {
   EXPECT_EQ(run({"replay"}), 2);
   EXPECT_EQ(run({"replay", "/nonexistent/capture.pcap", "--out", "/tmp/storey_replay_bad"}), 2);
   EXPECT_EQ(run({"replay", "x.pcap", "--rate", "-1"}), 2);
   EXPECT_EQ(run({"replay", "x.pcap", "--sensor", "hdl64"}), 2);
+  EXPECT_EQ(run({"replay", "x.pcap", "--config", "/nonexistent/storey.yaml"}), 2);
   const fs::path junk = fs::temp_directory_path() / "storey_junk.pcap";
   std::ofstream(junk) << "this is not a capture";
   EXPECT_EQ(run({"replay", junk.string(), "--out", "/tmp/storey_replay_bad"}), 2);

@@ -12,15 +12,12 @@
 #include "core/graph/graph_export.hpp"
 #include "core/map/ply_export.hpp"
 #include "firmware/autonomy.hpp"
+#include "firmware/commands.hpp"
 #include "rt/clock.hpp"
 #include "tools/sim/ground_truth.hpp"
 #include "tools/sim/render.hpp"
 #include "tools/sim/sim_platform.hpp"
 #include "tools/sim/world_sim.hpp"
-
-#ifndef STOREY_CONFIG_DIR
-#define STOREY_CONFIG_DIR "config"
-#endif
 
 namespace storey::tools::sim {
 
@@ -43,7 +40,7 @@ namespace {
 config::Parameters load_parameters(const std::string& path) {
   std::string file = path;
   if (file.empty()) {
-    file = std::string(STOREY_CONFIG_DIR) + "/default.yaml";
+    file = firmware::default_config_path();
     if (!fs::exists(file)) return config::Parameters{};  // installed without the tree: defaults
   }
   config::Result r = config::load(file);
