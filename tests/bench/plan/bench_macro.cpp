@@ -101,7 +101,7 @@ Scene& scene() {
   return *s;
 }
 
-void BM_PlanMacroCycle(benchmark::State& st) {
+void BM_MacroPlanCycle(benchmark::State& st) {
   Scene& s = scene();
   std::vector<double> ms;
   size_t hybrid_nodes = 0;
@@ -136,6 +136,6 @@ void BM_PlanMacroCycle(benchmark::State& st) {
   st.counters["clusters"] = double(s.h.clusters.clusters().size());
   st.counters["new_traj_frac"] = double(new_traj) / double(ms.size());
 }
-BENCHMARK(BM_PlanMacroCycle)->Unit(benchmark::kMillisecond)->Iterations(30);
+BENCHMARK(BM_MacroPlanCycle)->Unit(benchmark::kMillisecond)->Iterations(30);
 
 }  // namespace
