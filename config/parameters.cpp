@@ -212,15 +212,6 @@ void read_safety(SectionReader&& r, SafetyConfig& o) {
   r.get("trajectory_stale_s", o.trajectory_stale_s, Range{0.05, 60.0});
   r.get("link_timeout_s", o.link_timeout_s, Range{0.01, 10.0});
   r.get("lookahead_s", o.lookahead_s, Range{0.1, 10.0});
-  r.get("floor_stable_s", o.floor_stable_s, Range{0.0, 60.0});
-  r.get("floor_node_band_m", o.floor_node_band_m, Range{0.05, 5.0});
-  r.get("zone_clearance_radius_m", o.zone_clearance_radius_m, Range{0.1, 50.0});
-  r.get("hyp_height_window_m", o.hyp_height_window_m, Range{0.01, 5.0});
-  r.get("hyp_check_radius_m", o.hyp_check_radius_m, Range{0.5, 1000.0});
-  r.get("hyp_bridge_radius_m", o.hyp_bridge_radius_m, Range{0.1, 20.0});
-  r.get("zone_merge_cross_edges", o.zone_merge_cross_edges, Range{1, 10000});
-  r.get("zone_merge_distance_m", o.zone_merge_distance_m, Range{0.0, 100.0});
-  r.get("zone_visit_radius_m", o.zone_visit_radius_m, Range{0.1, 50.0});
   r.get("max_overruns", o.max_overruns, Range{1, 1000});
 }
 
