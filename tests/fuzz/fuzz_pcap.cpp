@@ -23,7 +23,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (f == nullptr) return 0;
   char err[PCAP_ERRBUF_SIZE];
   pcap_t* p = pcap_fopen_offline_with_tstamp_precision(f, PCAP_TSTAMP_PRECISION_NANO, err);
-  if (p == nullptr) return 0;  // libpcap closed nothing: it owns f only on success
+  if (p == nullptr) {  // libpcap takes ownership of f only on success
+    std::fclose(f);
+    return 0;
+  }
   const int lt = pcap_datalink(p);
   pcap_pkthdr* h;
   const u_char* frame;
