@@ -136,6 +136,8 @@ class Autonomy {
   // Owner-side views for the run record, only while no task runs (after the lockstep loop or
   // stop()): the live map (PLY export, coverage).
   const core::map::TraversabilityMap& map_for_record() const { return map_; }
+  // The local planner (set-aside frontier nodes and their reasons, for the run record).
+  const core::plan::LocalPlanner& planner_for_record() const { return planner_; }
 
  private:
   enum Task { kIngest = 0, kMap, kPlan, kControl, kWatchdog, kTelemetry, kTaskCount };

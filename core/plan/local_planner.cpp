@@ -20,8 +20,24 @@ const char* to_string(LocalPlanStatus s) {
       return "no_reachable_target";
     case LocalPlanStatus::kNoRobotNode:
       return "no_robot_node";
+    case LocalPlanStatus::kStartBlocked:
+      return "start_blocked";
     case LocalPlanStatus::kBadInput:
       return "bad_input";
+  }
+  return "unknown";
+}
+
+const char* to_string(SetAsideReason r) {
+  switch (r) {
+    case SetAsideReason::kStillFrontierAtTarget:
+      return "still_frontier_at_target";
+    case SetAsideReason::kOverdue:
+      return "target_overdue";
+    case SetAsideReason::kAstarFailed:
+      return "astar_failed";
+    case SetAsideReason::kTrajectoryFailed:
+      return "trajectory_failed";
   }
   return "unknown";
 }
@@ -37,12 +53,18 @@ LocalPlanner::LocalPlanner(const RobotModel& robot, const PlanOptions& plan, dou
       builder_(robot, trajectory_options(plan)),
       checker_(robot, voxel_size_m) {}
 
-bool LocalPlanner::ignored(const Eigen::Vector3f& p) const {
+const SetAsideEntry* LocalPlanner::set_aside_at(const Eigen::Vector3f& p) const {
   const float r2 = float(opt_.set_aside_radius_m * opt_.set_aside_radius_m);
-  for (const Eigen::Vector3f& q : set_aside_)
-    if ((p.head<2>() - q.head<2>()).squaredNorm() <= r2 && std::abs(p.z() - q.z()) < 0.5f)
-      return true;
-  return false;
+  for (const SetAsideEntry& e : set_aside_)
+    if ((p.head<2>() - e.p_m.head<2>()).squaredNorm() <= r2 && std::abs(p.z() - e.p_m.z()) < 0.5f)
+      return &e;
+  return nullptr;
+}
+
+void LocalPlanner::set_aside_cluster(const graph::ReachableGraph& g,
+                                     const graph::FrontierCluster& c, double t_s,
+                                     SetAsideReason reason) {
+  for (graph::NodeId n : c.nodes) set_aside_.push_back({g.node(n).p_m, t_s, c.id, reason});
 }
 
 const graph::FrontierCluster* LocalPlanner::find_cluster(const LocalPlanInput& in,
@@ -69,39 +91,130 @@ void LocalPlanner::build_search_graph(const graph::ReachableGraph& g) {
   sg_ = SearchGraph::from_edges(pos_scratch_, edges_scratch_, /*undirected=*/true);
 }
 
-bool LocalPlanner::try_target(const LocalPlanInput& in, const Viewpoint& vp, LocalPlanResult& out) {
+// The body box with its margin may overlap an obstacle where the robot stands (tracking error,
+// a door jamb seen late at close range): then every trajectory from there collides at its very
+// first pose, and no target is ever reachable. The margin is what overlaps (the body itself is
+// clear), so Stage 3 starts at the nearest collision-free pose within a few decimetres instead,
+// which the control task reaches first (it tracks from the nearest point of a new trajectory).
+bool LocalPlanner::free_start(const LocalPlanInput& in) {
+  start_foot_m_ = in.robot_foot_m;
+  start_yaw_ = in.robot_yaw_rad;
+  BodyPose p{in.robot_foot_m, in.robot_yaw_rad, 0.0, in.t_s};
+  if (!checker_.check_poses(*in.view, std::span<const BodyPose>(&p, 1)).collides) return true;
+  constexpr int kDirs = 16;
+  constexpr double kYaws[] = {0.0, 0.3, -0.3, 0.6, -0.6, 1.2, -1.2, M_PI / 2, -M_PI / 2};
+  double best = std::numeric_limits<double>::infinity();
+  for (double d = 0.0; d <= opt_.escape_radius_m + 1e-9; d += 0.05)
+    for (int a = 0; a < (d > 0 ? kDirs : 1); ++a)
+      for (double dyaw : kYaws) {
+        const double cost = d + 0.15 * std::abs(dyaw);
+        if (cost >= best) continue;
+        const double th = 2.0 * M_PI * a / kDirs;
+        BodyPose q = p;
+        q.foot_m += Eigen::Vector3d(d * std::cos(th), d * std::sin(th), 0.0);
+        q.yaw_rad = in.robot_yaw_rad + dyaw;
+        if (const auto s =
+                in.view->support_surface_near(q.foot_m.cast<float>(), robot_.step_height_m))
+          q.foot_m.z() = s->height_m;
+        if (checker_.check_poses(*in.view, std::span<const BodyPose>(&q, 1)).collides) continue;
+        best = cost;
+        start_foot_m_ = q.foot_m;
+        start_yaw_ = q.yaw_rad;
+      }
+  return std::isfinite(best);
+}
+
+bool LocalPlanner::can_turn(const map::MapView& view, const Eigen::Vector3d& foot, double yaw) {
+  constexpr int kYaws = 24;  // 15 deg
+  BodyPose p[kYaws];
+  for (int k = 0; k < kYaws; ++k) p[k] = BodyPose{foot, yaw + 2.0 * M_PI * k / kYaws, 0.0, 0.0};
+  return !checker_.check_poses(view, std::span<const BodyPose>(p, kYaws)).collides;
+}
+
+// A straight step at constant yaw (the legs walk sideways or backwards as well) to the nearest
+// pose within escape_turn_radius_m where the body can turn on the spot.
+bool LocalPlanner::escape(const LocalPlanInput& in, LocalPlanResult& out) {
+  if (can_turn(*in.view, start_foot_m_, start_yaw_)) return false;
+  constexpr int kDirs = 16;
+  const double spacing = 0.1;
+  for (double d = 0.1; d <= opt_.escape_turn_radius_m + 1e-9; d += 0.1)
+    for (int a = 0; a < kDirs; ++a) {
+      const double th = 2.0 * M_PI * a / kDirs;
+      Eigen::Vector3d b = start_foot_m_ + Eigen::Vector3d(d * std::cos(th), d * std::sin(th), 0);
+      const auto s = in.view->support_surface_near(b.cast<float>(), robot_.step_height_m);
+      if (!s || !s->reachable) continue;
+      b.z() = s->height_m;
+      if (!can_turn(*in.view, b, start_yaw_)) continue;
+      std::vector<Eigen::Vector3d> c(3, start_foot_m_);
+      const int n = std::max(1, int(std::ceil(d / spacing)));
+      for (int j = 1; j < n; ++j)
+        c.push_back(start_foot_m_ + (b - start_foot_m_) * (double(j) / n));
+      c.insert(c.end(), 3, b);
+      // Knot interval: half speed, and the acceleration limit at the tripled ends.
+      const double dt = std::max(d / n / (0.5 * robot_.max_speed_mps),
+                                 std::sqrt(d / n / std::max(robot_.max_accel_mps2, 1e-3)));
+      const std::vector<double> yaw(c.size(), start_yaw_);
+      BsplineTrajectory t(std::move(c), yaw, dt, in.t_s);
+      if (checker_
+              .check_ahead(
+                  *in.view, [&](double tt) { return t.pose(tt); }, t.t_start(), t.duration(), 0.0)
+              .collides)
+        continue;
+      out.trajectory = std::move(t);
+      out.path_m = {start_foot_m_, b};
+      out.target_m = b;
+      out.target_yaw_rad = start_yaw_;
+      out.real_until_s = out.trajectory.t_end();
+      return true;
+    }
+  return false;
+}
+
+bool LocalPlanner::try_target(const LocalPlanInput& in, const Viewpoint& vp, LocalPlanResult& out,
+                              SetAsideReason* why) {
+  *why = SetAsideReason::kAstarFailed;
   ++out.astar_calls;
-  VoxelPath path = astar_.plan(*in.view, in.robot_foot_m, vp.p_m);
+  VoxelPath path = astar_.plan(*in.view, start_foot_m_, vp.p_m);
   // The ground under the feet may be in the LiDAR's blind ring (start-up): search from the
   // nearest confirmed graph nodes instead, the closest observed support the robot stands by.
   for (size_t k = 0; path.status == VoxelAStarStatus::kNoStartSupport && k < start_nodes_m_.size();
        ++k) {
     path = astar_.plan(*in.view, start_nodes_m_[k], vp.p_m);
     if (path.status == VoxelAStarStatus::kOk)
-      path.points_m.insert(path.points_m.begin(), in.robot_foot_m);
+      path.points_m.insert(path.points_m.begin(), start_foot_m_);
   }
-  if (path.status != VoxelAStarStatus::kOk && vp.node < sg_.num_nodes() &&
-      robot_node_ < sg_.num_nodes()) {
-    // Fallback: the path along G_real. Its edges were checked over the support surface by the
-    // graph (tentative ones may bridge short under-observed gaps, max_gap_m): what a sparse
-    // standstill VLP-16 map (rings of ground 0.3-0.4 m apart) still supports. The B-spline
-    // below is checked against the body with FCL like any other path.
+  // The path along G_real: its edges were checked over the support surface by the graph
+  // (tentative ones may bridge short under-observed gaps, max_gap_m), with the body's half width
+  // beside them: what a sparse standstill VLP-16 map (rings of ground 0.3-0.4 m apart) still
+  // supports, and a second opinion where the voxel A* path hugs a door jamb.
+  auto graph_path = [&]() {
+    if (vp.node >= sg_.num_nodes() || robot_node_ >= sg_.num_nodes()) return false;
     const PathResult gp = pair_search_.astar(sg_, robot_node_, vp.node);
-    if (gp.found) {
-      path.points_m.clear();
-      path.points_m.push_back(in.robot_foot_m);
-      for (uint32_t u : gp.nodes) path.points_m.push_back(sg_.position(u));
-      if (path.points_m.size() == 2) path.points_m.push_back(vp.p_m);
-      path.status = VoxelAStarStatus::kOk;
-      ++out.graph_fallbacks;
-    }
-  }
+    if (!gp.found) return false;
+    path.points_m.clear();
+    path.points_m.push_back(start_foot_m_);
+    for (uint32_t u : gp.nodes) path.points_m.push_back(sg_.position(u));
+    if (path.points_m.size() == 2) path.points_m.push_back(vp.p_m);
+    path.status = VoxelAStarStatus::kOk;
+    ++out.graph_fallbacks;
+    return true;
+  };
+  bool on_graph = false;
+  if (path.status != VoxelAStarStatus::kOk) on_graph = graph_path();
   if (path.status != VoxelAStarStatus::kOk || path.points_m.empty()) return false;
-  // The path starts at the robot's support voxel; start the curve at the robot itself.
-  path.points_m.front() = in.robot_foot_m;
+  *why = SetAsideReason::kTrajectoryFailed;
+  // The path starts at the robot's support voxel; start the curve at the robot itself (or at
+  // the nearest collision-free pose, see free_start()). The B-spline is checked against the
+  // body with FCL whichever path it follows.
+  path.points_m.front() = start_foot_m_;
   TrajectoryResult tr =
-      builder_.build(*in.view, checker_, path.points_m, in.robot_yaw_rad, vp.yaw_rad, in.t_s);
-  if (tr.status != TrajectoryStatus::kOk && tr.status != TrajectoryStatus::kPolyline) return false;
+      builder_.build(*in.view, checker_, path.points_m, start_yaw_, vp.yaw_rad, in.t_s);
+  if (tr.status != TrajectoryStatus::kOk && tr.status != TrajectoryStatus::kPolyline) {
+    if (on_graph || !graph_path()) return false;
+    tr = builder_.build(*in.view, checker_, path.points_m, start_yaw_, vp.yaw_rad, in.t_s);
+    if (tr.status != TrajectoryStatus::kOk && tr.status != TrajectoryStatus::kPolyline)
+      return false;
+  }
   out.trajectory = std::move(tr.trajectory);
   out.path_m = std::move(path.points_m);
   out.target_m = vp.p_m;
@@ -135,7 +248,9 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
         const bool approached =
             std::find(approached_.begin(), approached_.end(), target_cluster_) != approached_.end();
         if (approached || !reached) {
-          for (graph::NodeId n : tc->nodes) set_aside_.push_back(g.node(n).p_m);
+          set_aside_cluster(
+              g, *tc, in.t_s,
+              reached ? SetAsideReason::kStillFrontierAtTarget : SetAsideReason::kOverdue);
         } else {
           approached_.push_back(target_cluster_);
         }
@@ -305,16 +420,22 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
 
   // ---- Stage 3: voxel A* + B-spline to the first viewpoint; on failure the cluster's other
   // candidates, then the next clusters (bounded).
+  if (!free_start(in)) {  // boxed in on the map: no cluster is to blame
+    out.status = LocalPlanStatus::kStartBlocked;
+    return out;
+  }
   int attempts = 0;
+  std::vector<std::pair<size_t, SetAsideReason>> failed;  // (index into order, why)
   for (size_t m = 0; m < order.size() && attempts < opt_.max_stage3_attempts; ++m) {
     const Candidate& c = sel[order[m]];
     std::vector<Viewpoint> vps = m < window.size() ? window[m] : viewpoints_of(c);
     if (m == 0 && dp.status == DpStatus::kOk && !dp.choice.empty())
       std::rotate(vps.begin(), vps.begin() + dp.choice[0], vps.begin() + dp.choice[0] + 1);
     bool ok = false;
+    SetAsideReason why = SetAsideReason::kAstarFailed;
     for (size_t k = 0; k < vps.size() && attempts < opt_.max_stage3_attempts && !ok;
          ++k, ++attempts)
-      ok = try_target(in, vps[k], out);
+      ok = try_target(in, vps[k], out, &why);
     if (ok) {
       has_target_ = true;
       target_cluster_ = c.cluster_id;
@@ -325,13 +446,29 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
       out.status = LocalPlanStatus::kNewTrajectory;
       return out;
     }
-    // Stage 3 failed for this cluster: after max_failures cycles it is set aside.
+    failed.push_back({m, why});
+  }
+  // Every attempt failed. If the robot cannot turn where it stands (a dead end narrower than
+  // the body's turning circle: every path back starts with a turn), the clusters are not to
+  // blame: step straight to the nearest pose where it can turn, and plan again from there.
+  if (!failed.empty() && escape(in, out)) {
+    has_target_ = true;
+    target_cluster_ = -1;
+    target_m_ = out.target_m;
+    current_ = out.trajectory;
+    planned_at_s_ = in.t_s;
+    out.replan_reason = "escape: cannot turn here";
+    out.status = LocalPlanStatus::kNewTrajectory;
+    return out;
+  }
+  // Stage 3 failed for these clusters: after max_failures cycles a cluster is set aside.
+  for (const auto& [m, why] : failed) {
+    const Candidate& c = sel[order[m]];
     auto it = std::find_if(failures_.begin(), failures_.end(),
                            [&](const auto& f) { return f.first == c.cluster_id; });
     if (it == failures_.end()) it = failures_.insert(failures_.end(), {c.cluster_id, 0});
     if (++it->second >= opt_.max_failures) {
-      for (graph::NodeId nd : (*in.clusters)[c.cluster_index].nodes)
-        set_aside_.push_back(g.node(nd).p_m);
+      set_aside_cluster(g, (*in.clusters)[c.cluster_index], in.t_s, why);
       failures_.erase(it);
     }
   }

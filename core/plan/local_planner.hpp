@@ -52,6 +52,7 @@ enum class LocalPlanStatus : uint8_t {
   kNoFrontiers,        // no TF cluster left
   kNoReachableTarget,  // clusters left, but none reachable / observable (see counts)
   kNoRobotNode,        // the robot has no node in G_real yet (map still growing)
+  kStartBlocked,       // no collision-free pose near the robot to start a trajectory from
   kBadInput,
 };
 const char* to_string(LocalPlanStatus s);
@@ -71,13 +72,31 @@ struct LocalPlanResult {
   uint32_t graph_fallbacks = 0;  // Stage 3 paths taken along G_real (voxel A* failed)
 };
 
+// Why frontier nodes were set aside (diagnostics: the run record lists them).
+enum class SetAsideReason : uint8_t {
+  kStillFrontierAtTarget = 0,  // stood at the viewpoint and on the frontier, still a frontier
+  kOverdue,                    // trajectory ended long ago without reaching the viewpoint
+  kAstarFailed,                // Stage 3: no voxel A* path (and none along G_real)
+  kTrajectoryFailed,           // Stage 3: a path, but no collision-free B-spline
+};
+const char* to_string(SetAsideReason r);
+
+struct SetAsideEntry {
+  Eigen::Vector3f p_m = Eigen::Vector3f::Zero();  // frontier node position when set aside
+  double t_s = 0;                                 // when
+  int32_t cluster_id = -1;
+  SetAsideReason reason = SetAsideReason::kStillFrontierAtTarget;
+};
+
 struct LocalPlannerOptions {
-  int max_tsp_clusters = 12;        // nearest clusters (graph distance) entering Stage 1
-  double replan_period_s = 4.0;     // re-optimise a kept target this often
-  double reached_radius_m = 0.5;    // robot this close to the viewpoint = reached
-  double set_aside_radius_m = 0.3;  // a frontier node this close to a set-aside one is ignored
-  int max_failures = 2;             // Stage 3 failures before a cluster is set aside
-  int max_stage3_attempts = 6;      // viewpoints tried per cycle (bounded work)
+  int max_tsp_clusters = 12;          // nearest clusters (graph distance) entering Stage 1
+  double replan_period_s = 4.0;       // re-optimise a kept target this often
+  double reached_radius_m = 0.5;      // robot this close to the viewpoint = reached
+  double set_aside_radius_m = 0.3;    // a frontier node this close to a set-aside one is ignored
+  int max_failures = 2;               // Stage 3 failures before a cluster is set aside
+  int max_stage3_attempts = 6;        // viewpoints tried per cycle (bounded work)
+  double escape_radius_m = 0.3;       // start pose in collision: free start searched this far
+  double escape_turn_radius_m = 0.8;  // cannot turn on the spot: a turning place this far
 };
 
 class LocalPlanner {
@@ -89,6 +108,10 @@ class LocalPlanner {
   void drop_target() { has_target_ = false; }
   bool has_target() const { return has_target_; }
   size_t set_aside_nodes() const { return set_aside_.size(); }
+  // Diagnostics: the set-aside frontier nodes with their reasons; the entry of the set-aside
+  // node nearest p (within set_aside_radius_m), or nullptr.
+  const std::vector<SetAsideEntry>& set_aside() const { return set_aside_; }
+  const SetAsideEntry* set_aside_at(const Eigen::Vector3f& p) const;
 
  private:
   struct Candidate {
@@ -96,10 +119,17 @@ class LocalPlanner {
     size_t cluster_index;
     uint32_t rep;  // representative node (nearest the centroid)
   };
-  bool ignored(const Eigen::Vector3f& p) const;
+  bool ignored(const Eigen::Vector3f& p) const { return set_aside_at(p) != nullptr; }
+  void set_aside_cluster(const graph::ReachableGraph& g, const graph::FrontierCluster& c,
+                         double t_s, SetAsideReason reason);
   const graph::FrontierCluster* find_cluster(const LocalPlanInput& in, int32_t id) const;
   void build_search_graph(const graph::ReachableGraph& g);
-  bool try_target(const LocalPlanInput& in, const Viewpoint& vp, LocalPlanResult& out);
+  // Stage 3 to one viewpoint; on failure *why says A* or trajectory.
+  bool free_start(const LocalPlanInput& in);
+  bool can_turn(const map::MapView& view, const Eigen::Vector3d& foot, double yaw);
+  bool escape(const LocalPlanInput& in, LocalPlanResult& out);
+  bool try_target(const LocalPlanInput& in, const Viewpoint& vp, LocalPlanResult& out,
+                  SetAsideReason* why);
 
   RobotModel robot_;
   PlanOptions plan_opt_;
@@ -115,6 +145,8 @@ class LocalPlanner {
   std::vector<Eigen::Vector3d> pos_scratch_;
 
   uint32_t robot_node_ = 0xFFFFFFFFu;
+  Eigen::Vector3d start_foot_m_ = Eigen::Vector3d::Zero();  // Stage 3 start (free_start())
+  double start_yaw_ = 0;
   std::vector<Eigen::Vector3d> start_nodes_m_;  // nearest confirmed nodes (blind-ring starts)
   // Current target.
   bool has_target_ = false;
@@ -123,7 +155,7 @@ class LocalPlanner {
   BsplineTrajectory current_;
   double planned_at_s_ = 0;
   // Frontier nodes set aside (positions: node ids are recycled) and Stage 3 failures per cluster.
-  std::vector<Eigen::Vector3f> set_aside_;
+  std::vector<SetAsideEntry> set_aside_;
   std::vector<std::pair<int32_t, int>> failures_;
   std::vector<int32_t>
       approached_;  // clusters whose viewpoint was reached once (walk onto them next)

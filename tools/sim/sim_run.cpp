@@ -14,6 +14,7 @@
 #include "firmware/autonomy.hpp"
 #include "firmware/commands.hpp"
 #include "rt/clock.hpp"
+#include "tools/sim/exploration_diagnostics.hpp"
 #include "tools/sim/ground_truth.hpp"
 #include "tools/sim/render.hpp"
 #include "tools/sim/sim_platform.hpp"
@@ -194,6 +195,12 @@ void write_record(const RecordInputs& in, std::vector<std::string>& written) {
     pictures.push_back("side.png");
   }
   for (const auto& p : pictures) written.push_back(p);
+  {
+    std::ofstream d(dir + "/diagnostics.md");
+    d << exploration_diagnostics(*in.autonomy, *in.gt,
+                                 in.path->empty() ? Eigen::Vector3d::Zero() : in.path->back());
+    written.push_back("diagnostics.md");
+  }
 
   // report.md ties it together.
   std::ofstream r(dir + "/report.md");
@@ -330,9 +337,10 @@ SimRunResult run_exploration(const SimRunOptions& opt) {
         std::snprintf(
             line, sizeof line,
             "[sim %7.1f s] coverage %5.1f %%  floor %d  nodes %u  frontiers %u (clusters %u)"
-            "  stops %llu",
+            "  stops %llu  plan %s",
             t, 100 * c.traversable_coverage, st.floor_hint, st.nodes, st.frontier_nodes,
-            st.clusters, (unsigned long long)autonomy.safety_stops());
+            st.clusters, (unsigned long long)autonomy.safety_stops(),
+            core::plan::to_string(st.last_plan));
         progress(line);
       }
       if (done) {
