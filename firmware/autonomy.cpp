@@ -270,7 +270,12 @@ void Autonomy::plan_step() {
     const bool exhausted = r.status == LocalPlanStatus::kNoFrontiers ||
                            r.clusters_set_aside + r.clusters_unreachable >= r.clusters_total;
     if (!exhausted) idle_since_s_ = now;
-    if (w.settled && w.graph.node_count() > 0 && now - idle_since_s_ >= opt_.complete_after_s)
+    // The graph's bounded per-cycle work can keep churning on sensor noise (a node appears and
+    // is pruned again) without ever yielding a reachable target: after a longer grace the
+    // exhausted planner alone decides.
+    const double idle_s = now - idle_since_s_;
+    if (w.graph.node_count() > 0 && ((w.settled && idle_s >= opt_.complete_after_s) ||
+                                     idle_s >= opt_.complete_unsettled_after_s))
       complete_ = true;
   } else if (r.status != LocalPlanStatus::kKeep) {
     idle_since_s_ = -1;

@@ -93,6 +93,7 @@ struct AutonomyOptions {
   // not wait for a slow task, and wall-time overruns would make the run non-deterministic.
   bool stop_on_overruns = true;
   double complete_after_s = 3.0;  // no target for this long with a settled graph = complete
+  double complete_unsettled_after_s = 10.0;  // ... or this long while the graph still churns
   // Ground under the robot at start-up, which the LiDAR cannot see, entered as support up to
   // this radius (capped at the blind radius + 0.3 m; 0 = off). See insert_startup_support().
   double startup_support_radius_m = 3.0;

@@ -27,8 +27,9 @@ TEST(ExploreHouse, GroundFloorSafelyAndDeterministically) {
   EXPECT_EQ(m.collisions, 0u);
   EXPECT_EQ(m.falls, 0u);
   ASSERT_EQ(m.floors_total, 2);
-  // Measured 0.69 with the local layer alone (docs/RESULTS.md); the DESIGN bar is 0.95.
-  EXPECT_GE(m.per_floor[0].traversable_coverage, 0.6);
+  // Measured 0.871 with the local layer alone, complete at 101 s (docs/RESULTS.md); the DESIGN
+  // bar is 0.95 on every floor. The upper floor needs the macro layer (ExplorationPlanner).
+  EXPECT_GE(m.per_floor[0].traversable_coverage, 0.8);
   EXPECT_GT(m.trajectory_length_m, 5.0);
   EXPECT_LT(m.exploration_time_s, 300.0);
 
