@@ -3,11 +3,11 @@
 #include <algorithm>
 #include <cstring>
 
-#include "drivers/go2/crc32.hpp"
+#include "drivers/crc.hpp"
 
 namespace storey::drivers::can {
 
-using storey::drivers::go2::crc32;
+using storey::drivers::crc32_zlib;
 
 size_t transfer_frame_count(size_t body_len, bool fd) {
   const size_t chunk = fd ? kFdChunk : kClassicChunk;
@@ -21,7 +21,7 @@ size_t encode_transfer(uint32_t id, const uint8_t* body, size_t body_len, uint8_
   if (total > kMaxTransferSize || frames > kMaxFramesPerTransfer || frames > max_frames) return 0;
   uint8_t buf[kMaxTransferSize];
   std::memcpy(buf, body, body_len);
-  const uint32_t crc = crc32(body, body_len);
+  const uint32_t crc = crc32_zlib({body, body_len});
   for (int i = 0; i < 4; ++i) buf[body_len + i] = static_cast<uint8_t>(crc >> (8 * i));
   const size_t chunk = fd ? kFdChunk : kClassicChunk;
   for (size_t i = 0; i < frames; ++i) {
@@ -92,7 +92,7 @@ CanReassembler::Result CanReassembler::push(const CanFrame& f) {
   s->active = false;
   uint32_t got = 0;
   for (int i = 0; i < 4; ++i) got |= static_cast<uint32_t>(s->buf[s->body_len + i]) << (8 * i);
-  if (crc32(s->buf.data(), s->body_len) != got) return Result::bad_crc;
+  if (crc32_zlib({s->buf.data(), s->body_len}) != got) return Result::bad_crc;
   body_ = s->buf.data();
   body_len_ = s->body_len;
   return Result::complete;

@@ -5,7 +5,7 @@
 //              data[1..] the next chunk of the transfer (7 bytes classic, 63 bytes FD)
 // The receiver knows the transfer length from the id (fixed-size messages), so no length field;
 // the counter keeps frames of consecutive transfers from being mixed after a loss.
-// Dependency-free (std + crc32.hpp): compiled standalone by the fuzz target.
+// Dependency-free (std + drivers/crc.hpp): compiled standalone by the fuzz target.
 #pragma once
 
 #include <array>

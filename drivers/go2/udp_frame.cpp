@@ -2,7 +2,7 @@
 
 #include <cstring>
 
-#include "drivers/go2/crc32.hpp"
+#include "drivers/crc.hpp"
 
 namespace storey::drivers::go2 {
 
@@ -39,7 +39,7 @@ size_t encode_udp_frame(const FrameHeader& h, const uint8_t* payload, size_t pay
   put_u64(out + 12, static_cast<uint64_t>(h.timestamp_ns));
   if (payload_len > 0) std::memcpy(out + kUdpHeaderSize, payload, payload_len);
   const size_t n = kUdpHeaderSize + payload_len;
-  put_u32(out + n, crc32(out, n));
+  put_u32(out + n, crc32_zlib({out, n}));
   return n + kUdpCrcSize;
 }
 
@@ -51,7 +51,7 @@ FrameError decode_udp_frame(const uint8_t* data, size_t len, FrameHeader& h,
   const size_t n = get_u16(data + 6);
   if (kUdpHeaderSize + n + kUdpCrcSize != len) return FrameError::bad_length;
   // CRC before interpreting the type: a corrupted type byte is a CRC failure, not a decode error.
-  if (crc32(data, kUdpHeaderSize + n) != get_u32(data + kUdpHeaderSize + n)) {
+  if (crc32_zlib({data, kUdpHeaderSize + n}) != get_u32(data + kUdpHeaderSize + n)) {
     return FrameError::bad_crc;
   }
   const size_t expected = payload_size(data[3]);

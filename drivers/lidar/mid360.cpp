@@ -5,7 +5,7 @@
 #include <cstring>
 #include <limits>
 
-#include "drivers/lidar/crc.hpp"
+#include "drivers/crc.hpp"
 
 namespace storey::drivers::lidar {
 

@@ -6,7 +6,7 @@
 #include <cstring>
 #include <limits>
 
-#include "drivers/go2/crc32.hpp"
+#include "drivers/crc.hpp"
 #include "drivers/go2/udp_frame.hpp"
 
 namespace storey::drivers::go2 {
@@ -35,10 +35,10 @@ RobotState sample_state() {
 
 TEST(Crc32, ZlibCheckValue) {
   const char* s = "123456789";
-  EXPECT_EQ(crc32(reinterpret_cast<const uint8_t*>(s), 9), 0xCBF43926u);
+  EXPECT_EQ(crc32_zlib({reinterpret_cast<const uint8_t*>(s), 9}), 0xCBF43926u);
   // Incremental == one shot.
-  const uint32_t a = crc32_update(0, reinterpret_cast<const uint8_t*>(s), 4);
-  EXPECT_EQ(crc32_update(a, reinterpret_cast<const uint8_t*>(s) + 4, 5), 0xCBF43926u);
+  const uint32_t a = crc32_zlib({reinterpret_cast<const uint8_t*>(s), 4});
+  EXPECT_EQ(crc32_zlib({reinterpret_cast<const uint8_t*>(s) + 4, 5}, a), 0xCBF43926u);
 }
 
 TEST(MessageCodec, StateRoundTripIsExact) {
@@ -155,7 +155,7 @@ TEST(UdpFrame, RoundTripAndHeaderFields) {
   EXPECT_EQ(f[3], 2);
   EXPECT_EQ(get_u16(f + 6), kVelocityPayloadSize);
   EXPECT_EQ(get_u32(f + 8), 0xA1B2C3D4u);
-  EXPECT_EQ(get_u32(f + n - 4), crc32(f, n - 4));
+  EXPECT_EQ(get_u32(f + n - 4), crc32_zlib({f, n - 4}));
   FrameHeader d;
   const uint8_t* payload = nullptr;
   size_t len = 0;

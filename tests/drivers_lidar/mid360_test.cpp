@@ -7,7 +7,7 @@
 #include <cstring>
 #include <vector>
 
-#include "drivers/lidar/crc.hpp"
+#include "drivers/crc.hpp"
 
 namespace storey::drivers::lidar {
 namespace {

@@ -1,12 +1,13 @@
 #pragma once
-// CRCs of the Livox SDK2 protocol (PROTOCOLS.md): CRC-16/CCITT-FALSE for command headers and the
-// zlib CRC-32 for payloads. Table-driven, tables built at compile time. Header-only, std only.
+// The CRCs of the drivers' wire formats: CRC-16/CCITT-FALSE (Livox SDK2 command headers) and the
+// zlib CRC-32 (Livox point payloads, the Go2 UDP link frames, CAN transfers). Table-driven, tables
+// built at compile time. Header-only and std-only, so the fuzz targets compile decoders alone.
 #include <array>
 #include <cstddef>
 #include <cstdint>
 #include <span>
 
-namespace storey::drivers::lidar {
+namespace storey::drivers {
 
 namespace crc_detail {
 constexpr std::array<uint16_t, 256> make_crc16_table() {
@@ -48,4 +49,4 @@ constexpr uint32_t crc32_zlib(std::span<const uint8_t> data, uint32_t prev = 0) 
   return ~c;
 }
 
-}  // namespace storey::drivers::lidar
+}  // namespace storey::drivers
