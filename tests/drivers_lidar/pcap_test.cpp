@@ -312,7 +312,8 @@ TEST(Lvx2, SyntheticRoundTripIntoMid360Decoder) {
   while (r.next(pkg)) {
     ASSERT_LT(idx, sent.size());
     EXPECT_EQ(pkg.frame_index, idx / 4);
-    EXPECT_EQ(pkg.header.lidar_id, dev.lidar_id);
+    const uint32_t lidar_id = pkg.header.lidar_id;  // packed field: copy, do not bind
+    EXPECT_EQ(lidar_id, uint32_t(dev.lidar_id));
     const std::size_t n = lvx2_to_sdk_packet(pkg, 4800, buf);
     ASSERT_GT(n, 0u);
     const auto info = dec.decode(std::span<const uint8_t>(buf).first(n), out);

@@ -200,9 +200,9 @@ TEST(LivePlatform, GarbageFloodIsCountedAndScansStillArrive) {
     if (i % 10 == 0) rig.platform->latest_pose(p);
     rig.send_packet(5.0f);
     for (int g = 0; g < 4; ++g) {  // four garbage datagrams per real one
-      uint8_t junk[1206];
+      uint8_t junk[1300];          // up to 1300 bytes are sent below
       for (auto& x : junk) x = uint8_t((seed = seed * 1664525u + 1013904223u) >> 24);
-      rig.send(junk, g == 0 ? sizeof junk : 1 + (seed >> 8) % 1300);
+      rig.send(junk, g == 0 ? 1206 : 1 + (seed >> 8) % 1300);  // 1206: a VLP-16-sized packet
     }
     std::this_thread::sleep_for(std::chrono::microseconds(300));
     while (rig.platform->take_scan(b)) scans.push_back(b);
