@@ -245,6 +245,10 @@ ExplorationResult ExplorationPlanner::plan(const ExplorationInput& in) {
       r.status = ExplorationStatus::kExploring;
       r.reason = "no graph node at the robot yet";
       return r;
+    case LocalPlanStatus::kStartBlocked:  // the body overlaps an obstacle: not "complete"
+      r.status = ExplorationStatus::kExploring;
+      r.reason = "no collision-free start pose near the robot";
+      return r;
     case LocalPlanStatus::kBadInput:
       r.status = ExplorationStatus::kFailed;
       r.reason = "local planner rejected the input";
