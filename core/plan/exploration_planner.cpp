@@ -7,6 +7,20 @@
 
 namespace storey::core::plan {
 
+namespace {
+// The local layer produced (or kept) a trajectory: it becomes the planner's result.
+void take_trajectory(LocalPlanResult& lr, ExplorationResult& r) {
+  r.status = lr.status == LocalPlanStatus::kKeep ? ExplorationStatus::kKeep
+                                                 : ExplorationStatus::kNewTrajectory;
+  r.reason = lr.replan_reason;
+  r.trajectory = std::move(lr.trajectory);
+  r.real_until_s = lr.real_until_s;
+  r.target_m = lr.target_m;
+  r.target_yaw_rad = lr.target_yaw_rad;
+  r.target_cluster = lr.target_cluster;
+}
+}  // namespace
+
 const char* to_string(ExplorationStatus s) {
   switch (s) {
     case ExplorationStatus::kNewTrajectory:
@@ -195,15 +209,8 @@ ExplorationResult ExplorationPlanner::plan(const ExplorationInput& in) {
           li.viewpoints = &sel_viewpoints_;
           LocalPlanResult lr = local_.plan(li);
           if (lr.status == LocalPlanStatus::kNewTrajectory || lr.status == LocalPlanStatus::kKeep) {
-            r.status = lr.status == LocalPlanStatus::kKeep ? ExplorationStatus::kKeep
-                                                           : ExplorationStatus::kNewTrajectory;
-            r.reason = lr.replan_reason;
-            r.trajectory = std::move(lr.trajectory);
-            r.real_until_s = lr.real_until_s;
-            r.target_m = lr.target_m;
-            r.target_yaw_rad = lr.target_yaw_rad;
-            r.target_cluster = lr.target_cluster;
             r.cluster_order = std::move(lr.cluster_order);
+            take_trajectory(lr, r);
             return r;
           }
         }
@@ -232,14 +239,7 @@ ExplorationResult ExplorationPlanner::plan(const ExplorationInput& in) {
   switch (lr.status) {
     case LocalPlanStatus::kNewTrajectory:
     case LocalPlanStatus::kKeep:
-      r.status = lr.status == LocalPlanStatus::kKeep ? ExplorationStatus::kKeep
-                                                     : ExplorationStatus::kNewTrajectory;
-      r.reason = lr.replan_reason;
-      r.trajectory = std::move(lr.trajectory);
-      r.real_until_s = lr.real_until_s;
-      r.target_m = lr.target_m;
-      r.target_yaw_rad = lr.target_yaw_rad;
-      r.target_cluster = lr.target_cluster;
+      take_trajectory(lr, r);
       return r;
     case LocalPlanStatus::kNoRobotNode:
       r.status = ExplorationStatus::kExploring;
