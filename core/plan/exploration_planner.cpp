@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/plan/path_centring.hpp"
 #include "core/plan/plan_config.hpp"
 
 namespace storey::core::plan {
@@ -20,6 +21,21 @@ void take_trajectory(LocalPlanResult& lr, ExplorationResult& r) {
   r.target_cluster = lr.target_cluster;
 }
 }  // namespace
+
+const char* to_string(PlanStage s) {
+  static constexpr const char* kNames[] = {
+      "floors",       "prior",    "hybrid_bind", "hybrid_check", "hybrid_compile",
+      "hybrid_zones", "global",   "local_keep",  "local_stage1", "local_stage2",
+      "local_stage3", "approach", "done"};
+  static_assert(sizeof(kNames) / sizeof(kNames[0]) == size_t(PlanStage::kCount));
+  return size_t(s) < size_t(PlanStage::kCount) ? kNames[size_t(s)] : "?";
+}
+
+void ExplorationPlanner::set_stage_probe(StageProbe* probe) {
+  probe_ = probe;
+  hybrid_.set_stage_probe(probe);
+  local_.set_stage_probe(probe);
+}
 
 const char* to_string(ExplorationStatus s) {
   switch (s) {
@@ -116,6 +132,8 @@ bool ExplorationPlanner::drive_to(const ExplorationInput& in, const Eigen::Vecto
   VoxelPath path = astar_.plan(*in.view, in.robot_foot_m, goal);
   if (path.status != VoxelAStarStatus::kOk || path.points_m.empty()) return false;
   path.points_m.front() = in.robot_foot_m;
+  centre_path(*in.view, path.points_m);
+  align_before_climbs(*in.view, path.points_m);
   const Eigen::Vector2d d = (goal - in.robot_foot_m).head<2>();
   const double yaw = d.norm() > 1e-6 ? std::atan2(d.y(), d.x()) : in.robot_yaw_rad;
   TrajectoryResult tr =
@@ -131,6 +149,13 @@ bool ExplorationPlanner::drive_to(const ExplorationInput& in, const Eigen::Vecto
 }
 
 ExplorationResult ExplorationPlanner::plan(const ExplorationInput& in) {
+  probe_mark(probe_, PlanStage::kFloors);
+  ExplorationResult r = plan_cycle(in);
+  probe_mark(probe_, PlanStage::kDone);
+  return r;
+}
+
+ExplorationResult ExplorationPlanner::plan_cycle(const ExplorationInput& in) {
   ExplorationResult r;
   if (!in.view || !in.graph || !in.clusters || !in.viewpoints || !in.robot_foot_m.allFinite() ||
       !std::isfinite(in.t_s)) {
@@ -147,6 +172,7 @@ ExplorationResult ExplorationPlanner::plan(const ExplorationInput& in) {
     const int32_t ref = floors_.choose_reference(r.floor);
     if (ref >= 0) {
       r.reference_floor = ref;
+      probe_mark(probe_, PlanStage::kPrior);
       build_prior(in, ref, r.floor, r);
     }
   }
@@ -172,6 +198,7 @@ ExplorationResult ExplorationPlanner::plan(const ExplorationInput& in) {
         return std::find(set_aside_zones_.begin(), set_aside_zones_.end(), id) !=
                set_aside_zones_.end();
       };
+      probe_mark(probe_, PlanStage::kGlobal);
       const GlobalPlan gp = global_.plan(hybrid_, robot_node, aside);
       r.zone_sequence = gp.zone_order;
       zones_left = !gp.zone_order.empty();
@@ -216,6 +243,7 @@ ExplorationResult ExplorationPlanner::plan(const ExplorationInput& in) {
         }
         // No cluster to serve in the first zones: follow the real prefix toward the first
         // zone's centre (Sec. IV-C). A prefix ending at the robot cannot make progress.
+        probe_mark(probe_, PlanStage::kApproach);
         const int32_t z0 = gp.zone_order.front();
         const Approach a = global_.approach(hybrid_, robot_node, centre_of(z0));
         const bool progress =

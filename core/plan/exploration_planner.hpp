@@ -30,6 +30,7 @@
 #include "core/plan/global_planner.hpp"
 #include "core/plan/hybrid_graph.hpp"
 #include "core/plan/local_planner.hpp"
+#include "core/plan/stage_probe.hpp"
 #include "core/plan/task_zones.hpp"
 
 namespace storey::core::plan {
@@ -90,8 +91,12 @@ class ExplorationPlanner {
   const HybridGraph& hybrid() const { return hybrid_; }
   const FloorTracker& floors() const { return floors_; }
   LocalPlanner& local() { return local_; }
+  // Per-stage profiling (stage_probe.hpp); nullptr: none. Passed on to the hybrid graph and the
+  // local layer. The probe must outlive the planner or be reset to nullptr.
+  void set_stage_probe(StageProbe* probe);
 
  private:
+  ExplorationResult plan_cycle(const ExplorationInput& in);
   void build_prior(const ExplorationInput& in, int32_t ref, int32_t target, ExplorationResult& r);
   void update_floor_progress(const graph::ReachableGraph& g);
   bool drive_to(const ExplorationInput& in, const Eigen::Vector3d& goal, ExplorationResult& r);
@@ -107,6 +112,7 @@ class ExplorationPlanner {
   VoxelAStar astar_;
   TrajectoryBuilder builder_;
   CollisionChecker checker_;
+  StageProbe* probe_ = nullptr;
   std::vector<int32_t> set_aside_zones_;
   // Scratch.
   std::vector<graph::FrontierCluster> sel_clusters_;

@@ -524,12 +524,16 @@ MaintenanceStats HybridGraph::update(const map::MapView& view, uint64_t map_vers
     csr_real_.clear();
     return st;
   }
+  probe_mark(probe_, PlanStage::kHybridBind);
   bind_real_nodes(g, floors, opt, st);
   if (map_version != last_version_) {
     last_version_ = map_version;
+    probe_mark(probe_, PlanStage::kHybridCheck);
     check_hypotheses(view, g, robot, opt, st);
   }
+  probe_mark(probe_, PlanStage::kHybridCompile);
   compile(view, g, floors, opt);
+  probe_mark(probe_, PlanStage::kHybridZones);
   if (opt.incremental_maintenance) maintain_zones(opt, st);
   collect_zones(robot, opt);
   st.hyp_alive = uint32_t(hypotheses_alive());

@@ -48,6 +48,7 @@
 #include "core/plan/floor_tracker.hpp"
 #include "core/plan/graph_search.hpp"
 #include "core/plan/plan_options.hpp"
+#include "core/plan/stage_probe.hpp"
 #include "core/plan/task_zones.hpp"
 
 namespace storey::core::plan {
@@ -121,6 +122,7 @@ class HybridGraph {
   }
   const std::vector<HybridZone>& zones() const { return zones_; }  // live zones only
   size_t hypotheses_alive() const;
+  void set_stage_probe(StageProbe* probe) { probe_ = probe; }
 
  private:
   struct HypNode {
@@ -160,6 +162,7 @@ class HybridGraph {
   uint64_t cell(double x, double y) const;
 
   int32_t target_floor_ = -1;
+  StageProbe* probe_ = nullptr;
   std::vector<HypNode> hyp_;
   std::vector<HypEdge> hyp_edges_;
   std::vector<std::vector<uint32_t>> hyp_adj_;           // hyp node -> hyp edge ids

@@ -235,6 +235,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   // ---- Keep the current target unless there is a reason to replan.
   const char* reason = "no target";
   if (has_target_) {
+  probe_mark(probe_, PlanStage::kLocalKeep);
     const graph::FrontierCluster* tc = find_cluster(in, target_cluster_);
     const double dxy = (in.robot_foot_m - target_m_).head<2>().norm();
     const bool reached =
@@ -290,6 +291,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   // ---- Stage 1: TSP over the cluster representatives (graph path costs).
   if (in.clusters->empty()) {
     out.status = LocalPlanStatus::kNoFrontiers;
+  probe_mark(probe_, PlanStage::kLocalStage1);
     return out;
   }
   build_search_graph(g);
@@ -378,6 +380,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   // ---- Stage 2: one viewpoint per cluster over the window W (Eq. 6).
   auto viewpoints_of = [&](const Candidate& c) {
     std::vector<Viewpoint> v;
+  probe_mark(probe_, PlanStage::kLocalStage2);
     for (const auto& cv : *in.viewpoints) {
       if (cv.cluster_id != c.cluster_id) continue;
       for (const auto& gv : cv.viewpoints) {
@@ -422,6 +425,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   // candidates, then the next clusters (bounded).
   if (!free_start(in)) {  // boxed in on the map: no cluster is to blame
     out.status = LocalPlanStatus::kStartBlocked;
+  probe_mark(probe_, PlanStage::kLocalStage3);
     return out;
   }
   int attempts = 0;

@@ -28,6 +28,7 @@
 #include "core/plan/collision_checker.hpp"
 #include "core/plan/graph_search.hpp"
 #include "core/plan/plan_options.hpp"
+#include "core/plan/stage_probe.hpp"
 #include "core/plan/tsp.hpp"
 #include "core/plan/viewpoint_dp.hpp"
 #include "core/plan/voxel_astar.hpp"
@@ -112,6 +113,7 @@ class LocalPlanner {
   // node nearest p (within set_aside_radius_m), or nullptr.
   const std::vector<SetAsideEntry>& set_aside() const { return set_aside_; }
   const SetAsideEntry* set_aside_at(const Eigen::Vector3f& p) const;
+  void set_stage_probe(StageProbe* probe) { probe_ = probe; }
 
  private:
   struct Candidate {
@@ -139,6 +141,7 @@ class LocalPlanner {
   VoxelAStar astar_;
   TrajectoryBuilder builder_;
   CollisionChecker checker_;
+  StageProbe* probe_ = nullptr;
   GraphSearch search_, pair_search_;
   SearchGraph sg_;
   std::vector<SearchGraph::Edge> edges_scratch_;

@@ -2,12 +2,16 @@
 // maintenance, global TSP over zones with two-stage costs, local Stage 1-3 and the B-spline) on
 // a building-size world: two 48 x 36 m floors with a wall grid (rooms joined by doors), mapped
 // by synthetic scans, the robot on floor 1 with the prior projected from floor 0.
-// Reports p50/p99 of the cycle [ms] and the graph sizes as counters.
+// Reports p50/p99 of the cycle [ms] (wall clock and the thread's CPU time: the machine is
+// shared), the mean time per stage [ms] (StageProbe) and the graph sizes as counters.
 #include <benchmark/benchmark.h>
+#include <time.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "core/plan/exploration_planner.hpp"
@@ -43,6 +47,32 @@ void building_floor(World& w, float z, bool all_doors_open) {
   w.add({-0.2f, 36, z}, {48.2f, 36.2f, z + 2.5f});
   w.add({-0.2f, -0.2f, z}, {0, 36.2f, z + 2.5f});
   w.add({48, -0.2f, z}, {48.2f, 36.2f, z + 2.5f});
+}
+
+double thread_cpu_ms() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) * 1e3 + double(ts.tv_nsec) * 1e-6;
+}
+
+// Wall time per stage of one cycle (the planner marks stage boundaries).
+struct StageClock final : StageProbe {
+  using Clock = std::chrono::steady_clock;
+  std::array<double, size_t(PlanStage::kCount)> ms{};
+  PlanStage cur = PlanStage::kDone;
+  Clock::time_point t0 = Clock::now();
+  void mark(PlanStage s) override {
+    const Clock::time_point t = Clock::now();
+    if (cur != PlanStage::kDone)
+      ms[size_t(cur)] += std::chrono::duration<double, std::milli>(t - t0).count();
+    cur = s;
+    t0 = t;
+  }
+};
+
+double percentile(std::vector<double> v, double q) {
+  std::sort(v.begin(), v.end());
+  return v[std::min(v.size() - 1, size_t(double(v.size()) * q))];
 }
 
 struct Scene {
@@ -103,7 +133,10 @@ Scene& scene() {
 
 void BM_MacroPlanCycle(benchmark::State& st) {
   Scene& s = scene();
-  std::vector<double> ms;
+  StageClock probe;
+  s.planner->set_stage_probe(&probe);
+  std::array<double, size_t(PlanStage::kCount)> stage_sum{};
+  std::vector<double> ms, cpu_ms;
   size_t hybrid_nodes = 0;
   int zones = 0, new_traj = 0;
   for (auto _ : st) {
@@ -117,19 +150,28 @@ void BM_MacroPlanCycle(benchmark::State& st) {
                         s.foot.cast<double>(),
                         0,
                         s.t};
+    probe.ms.fill(0);
+    const double c0 = thread_cpu_ms();
     const auto t0 = std::chrono::steady_clock::now();
     const ExplorationResult r = s.planner->plan(in);
     ms.push_back(
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    cpu_ms.push_back(thread_cpu_ms() - c0);
+    for (size_t k = 0; k < stage_sum.size(); ++k) stage_sum[k] += probe.ms[k];
     benchmark::DoNotOptimize(r.status);
     hybrid_nodes = s.planner->hybrid().nodes().size();
     zones = int(r.zones.size());
     new_traj += r.status == ExplorationStatus::kNewTrajectory;
   }
-  std::sort(ms.begin(), ms.end());
-  st.counters["p50_ms"] = ms[ms.size() / 2];
-  st.counters["p99_ms"] = ms[std::min(ms.size() - 1, size_t(double(ms.size()) * 0.99))];
-  st.counters["max_ms"] = ms.back();
+  s.planner->set_stage_probe(nullptr);
+  st.counters["p50_ms"] = percentile(ms, 0.5);
+  st.counters["p99_ms"] = percentile(ms, 0.99);
+  st.counters["max_ms"] = percentile(ms, 1.0);
+  st.counters["cpu_p50_ms"] = percentile(cpu_ms, 0.5);
+  st.counters["cpu_p99_ms"] = percentile(cpu_ms, 0.99);
+  for (size_t k = 0; k + 1 < stage_sum.size(); ++k)  // mean wall time per stage (kDone: none)
+    st.counters[std::string("stage_") + to_string(PlanStage(k)) + "_ms"] =
+        stage_sum[k] / double(ms.size());
   st.counters["real_nodes"] = double(s.h.graph.node_count());
   st.counters["hybrid_nodes"] = double(hybrid_nodes);
   st.counters["zones"] = zones;
