@@ -278,6 +278,7 @@ void HybridGraph::compile(const map::MapView& view, const graph::ReachableGraph&
   for (uint32_t u = 0; u < nodes_.size(); ++u) {
     if (node_hyp_[u] < 0) continue;
     const Eigen::Vector3f p = nodes_[u].p_m.cast<float>();
+    near_.clear();  // nodes_within appends
     g.nodes_within(p, float(opt.hyp_bridge_radius_m), float(opt.hyp_height_window_m), near_);
     std::sort(near_.begin(), near_.end(), [&](NodeId a, NodeId b) {
       const float da = (g.node(a).p_m - p).squaredNorm(), db = (g.node(b).p_m - p).squaredNorm();
