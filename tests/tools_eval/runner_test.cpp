@@ -1,0 +1,160 @@
+// The runner against a stand-in `storey` (a shell script that logs each call and writes a
+// metrics.json, or refuses a method like `storey sim` does): resumability, failure records,
+// interrupted folders.
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "test_util.hpp"
+#include "tools/eval/runner.hpp"
+
+namespace storey::tools::eval {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct FakeStorey {
+  std::string dir, script, calls;
+
+  FakeStorey() {
+    dir = test::fresh_dir("runner");
+    script = dir + "/storey";
+    calls = dir + "/calls.txt";
+    std::ofstream f(script);
+    f << "#!/bin/sh\n"
+         "out=''; seed=''; method=''; ablation=full\n"
+         "while [ $# -gt 0 ]; do case \"$1\" in --out) out=$2; shift;; --seed) seed=$2; shift;;\n"
+         "  --method) method=$2; shift;; --ablation) ablation=$2; shift;; esac; shift; done\n"
+         "echo \"$method $ablation $seed\" >> '"
+      << calls
+      << "'\n"
+         "echo 'storey sim: scene x, seed' $seed >&2\n"
+         "if [ \"$method\" = refused ]; then\n"
+         "  echo 'storey sim: --method refused: not available yet' >&2; exit 2; fi\n"
+         "if [ \"$method\" = crash ]; then kill -SEGV $$; fi\n"
+         "t=$((100 + 10 * seed))\n"
+         "cat > \"$out/metrics.json\" <<EOF\n"
+         "{\"success\": true, \"floors_total\": 1, \"floors_explored\": 1,\n"
+         " \"exploration_time_s\": $t, \"trajectory_length_m\": 50, \"traversable_volume_m3\": 1,\n"
+         " \"occupied_volume_m3\": 2, \"gt_traversable_volume_m3\": 1, \"gt_occupied_volume_m3\": "
+         "2,\n"
+         " \"traversable_coverage\": 0.97, \"per_floor\": [{\"z_m\": 0, \"time_s\": 90, "
+         "\"traversable_coverage\": 0.97}],\n"
+         " \"collisions\": 0, \"falls\": 0, \"safety_stops\": 0, \"latency\": {},\n"
+         " \"coverage_over_time\": [[0, 0], [$t, 0.97]]}\n"
+         "EOF\n"
+         "echo 'Outcome: **success** - exploration complete' > \"$out/report.md\"\n"
+         "echo \"$out/report.md\"\n";
+    f.close();
+    chmod(script.c_str(), 0755);
+  }
+  ~FakeStorey() { fs::remove_all(dir); }
+
+  std::vector<std::string> call_lines() const {
+    std::ifstream f(calls);
+    std::vector<std::string> v;
+    for (std::string l; std::getline(f, l);) v.push_back(l);
+    return v;
+  }
+  Runner runner(const std::string& out, int jobs = 2) const {
+    return Runner({script, jobs, out, 30, "", nullptr});
+  }
+};
+
+TEST(Runner, RunsEverySpecAndRecordsFailuresWithTheirReason) {
+  FakeStorey fake;
+  const std::string out = fake.dir + "/eval";
+  const auto specs = expand_matrix({{{"box"}, {"storey", "refused"}, {"full"}}}, {1, 2});
+  const auto res = fake.runner(out).run(specs);
+  ASSERT_EQ(res.size(), 4u);
+  EXPECT_EQ(fake.call_lines().size(), 4u);
+  for (size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(res[i].status, RunStatus::finished) << res[i].reason;
+    EXPECT_FALSE(res[i].resumed);
+    EXPECT_EQ(res[i].exit_code, 0);
+    EXPECT_EQ(res[i].reason, "exploration complete");
+    EXPECT_DOUBLE_EQ(res[i].metrics.exploration_time_s, 100.0 + 10.0 * double(i + 1));
+    // The child's output is in the folder's log; the folder is final (no .partial left).
+    const std::string dir = out + "/" + specs[i].rel_dir();
+    std::ifstream log(dir + "/log.txt");
+    std::stringstream ss;
+    ss << log.rdbuf();
+    EXPECT_NE(ss.str().find("storey sim: scene x, seed " + std::to_string(i + 1)),
+              std::string::npos);
+    EXPECT_TRUE(fs::exists(dir + "/eval.json"));
+    EXPECT_FALSE(fs::exists(dir + ".partial"));
+  }
+  for (size_t i = 2; i < 4; ++i) {
+    EXPECT_EQ(res[i].status, RunStatus::failed);
+    EXPECT_EQ(res[i].exit_code, 2);
+    EXPECT_EQ(res[i].reason, "storey sim: --method refused: not available yet");
+    // The failure survives in the folder for --report-only.
+    const RunOutcome again = load_outcome(specs[i], out + "/" + specs[i].rel_dir());
+    EXPECT_EQ(again.status, RunStatus::failed);
+    EXPECT_EQ(again.reason, res[i].reason);
+  }
+}
+
+TEST(Runner, ResumesFinishedRunsAndRetriesFailedAndBrokenOnes) {
+  FakeStorey fake;
+  const std::string out = fake.dir + "/eval";
+  const auto specs = expand_matrix({{{"box"}, {"storey", "refused"}, {"full"}}}, {1, 2, 3});
+  fake.runner(out).run(specs);
+  ASSERT_EQ(fake.call_lines().size(), 6u);
+
+  // Seed 2's metrics.json cut off mid-write (an old, interrupted layout), seed 3 a stale
+  // .partial folder: the first is redone, the second cleaned and ignored.
+  const std::string seed2 = out + "/runs/box/storey/seed2/metrics.json";
+  std::string text;
+  {
+    std::ifstream f(seed2);
+    std::stringstream ss;
+    ss << f.rdbuf();
+    text = ss.str();
+  }
+  test::write_text(seed2, text.substr(0, text.size() / 2));
+  test::write_text(out + "/runs/box/storey/seed3.partial/metrics.json", "{");
+
+  const auto res = fake.runner(out, 1).run(specs);
+  const auto calls = fake.call_lines();
+  ASSERT_EQ(calls.size(), 6u + 4u);  // seed 2 of storey + the three refused
+  EXPECT_EQ(calls[6], "storey full 2");
+  EXPECT_TRUE(res[0].resumed);
+  EXPECT_FALSE(res[1].resumed);
+  EXPECT_TRUE(res[2].resumed);
+  for (size_t i = 0; i < 3; ++i) EXPECT_EQ(res[i].status, RunStatus::finished);
+  EXPECT_EQ(res[0].exit_code, 0);  // from the eval.json kept in the folder
+  EXPECT_EQ(res[3].status, RunStatus::failed);
+
+  // Everything finished: a third invocation runs only the failed ones.
+  fake.runner(out).run(expand_matrix({{{"box"}, {"storey"}, {"full"}}}, {1, 2, 3}));
+  EXPECT_EQ(fake.call_lines().size(), 10u);
+}
+
+TEST(Runner, ASignalledOrMissingChildIsAFailedRunNotAnAbort) {
+  FakeStorey fake;
+  const std::string out = fake.dir + "/eval";
+  auto specs = expand_matrix({{{"box"}, {"crash", "storey"}, {"full"}}}, {1});
+  const auto res = fake.runner(out).run(specs);
+  ASSERT_EQ(res.size(), 2u);
+  EXPECT_EQ(res[0].status, RunStatus::failed);
+  EXPECT_EQ(res[0].reason.rfind("killed by signal 11", 0), 0u) << res[0].reason;
+  EXPECT_EQ(res[1].status, RunStatus::finished);
+
+  const auto missing =
+      Runner({fake.dir + "/no-such-storey", 1, out + "2", 30, "", nullptr}).run(specs);
+  EXPECT_EQ(missing[0].status, RunStatus::failed);
+  EXPECT_NE(missing[0].reason.find("no-such-storey"), std::string::npos) << missing[0].reason;
+}
+
+TEST(Runner, FormatDuration) {
+  EXPECT_EQ(format_duration(12.2), "12s");
+  EXPECT_EQ(format_duration(245), "4m05s");
+  EXPECT_EQ(format_duration(3720), "1h02m");
+}
+
+}  // namespace
+}  // namespace storey::tools::eval

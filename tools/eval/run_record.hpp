@@ -1,0 +1,66 @@
+// What one run left behind: its metrics.json (fields of tools/sim/metrics.cpp), the end reason
+// (from metrics.json when it carries one, else the Outcome line of report.md) and the runner's
+// own eval.json (exit status, failure reason, wall time).
+#pragma once
+
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "tools/eval/run_matrix.hpp"
+
+namespace storey::tools::eval {
+
+struct FloorRecord {
+  double z_m = 0.0;
+  double time_s = -1.0;  // first time the floor reached 90 % coverage; < 0 = never
+  double traversable_coverage = 0.0;
+};
+
+struct MetricsRecord {
+  bool success = false;
+  int floors_total = 0, floors_explored = 0;
+  double exploration_time_s = 0.0, trajectory_length_m = 0.0;
+  double traversable_volume_m3 = 0.0, occupied_volume_m3 = 0.0;
+  double gt_traversable_volume_m3 = 0.0, gt_occupied_volume_m3 = 0.0;
+  double traversable_coverage = 0.0;
+  std::vector<FloorRecord> per_floor;
+  double collisions = 0, falls = 0, safety_stops = 0;
+  std::vector<std::pair<double, double>> coverage_over_time;  // (t [s], coverage 0..1)
+  std::string end_reason;                                     // "" when not recorded
+};
+
+// A metrics.json is complete when it parses as a whole and holds every field above (a record cut
+// off while being written does not parse). nullopt with *error naming the file otherwise.
+std::optional<MetricsRecord> read_metrics_json(const std::string& path, std::string* error);
+// The reason after "Outcome: **...** - " in report.md; "" when there is none.
+std::string read_report_outcome(const std::string& report_md_path);
+// The last non-empty line of a text file (a failed child's reason); "" when none.
+std::string last_line(const std::string& path);
+
+enum class RunStatus {
+  finished,  // complete metrics.json (success or not: a baseline that stays on one floor finishes)
+  failed,    // the child left no complete metrics.json, or the run itself failed ("run failed:")
+  not_run,   // nothing in the folder (--report-only, or interrupted)
+};
+const char* to_string(RunStatus s);
+
+struct RunOutcome {
+  RunSpec spec;
+  RunStatus status = RunStatus::not_run;
+  bool resumed = false;   // finished in an earlier storey-eval invocation
+  int exit_code = -1;     // the child's exit code; -1 when unknown (killed, or not recorded)
+  std::string reason;     // failed: why (the child's last stderr line); finished: end reason
+  double wall_s = 0.0;    // wall-clock seconds the child took (0 when unknown)
+  MetricsRecord metrics;  // valid when status == finished
+};
+
+// Reads a run folder (DIR/runs/...): finished when metrics.json is complete; failed when the
+// runner's eval.json says so; not_run otherwise.
+RunOutcome load_outcome(const RunSpec& spec, const std::string& run_dir);
+// Writes run_dir/eval.json for `o` (status, exit code, reason, wall time, the command).
+void write_eval_record(const RunOutcome& o, const std::string& run_dir,
+                       const std::vector<std::string>& command);
+
+}  // namespace storey::tools::eval
