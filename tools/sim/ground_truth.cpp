@@ -27,6 +27,9 @@ GroundTruth::GroundTruth(const Mesh& mesh, const std::optional<StartPose>& start
     : opt_(options) {
   if (mesh.empty()) throw std::runtime_error("ground truth: empty mesh");
   if (!(opt_.resolution > 0.0)) throw std::runtime_error("ground truth: resolution must be > 0");
+  if (!(opt_.collision_radius >= 0.0 && opt_.collision_radius <= 2.0))
+    throw std::runtime_error("ground truth: collision_radius must be in [0, 2] m (got " +
+                             std::to_string(opt_.collision_radius) + ")");
   bounds_ = mesh.bounds();
   const double r = opt_.resolution;
   const int clear = static_cast<int>(std::ceil(opt_.body_clearance / r - 1e-9));
@@ -39,8 +42,10 @@ GroundTruth::GroundTruth(const Mesh& mesh, const std::optional<StartPose>& start
   const double cells = double(nx_) * ny_ * nz_;
   if (cells > 2e9) throw std::runtime_error("ground truth: world too large for a dense grid");
   grid_.assign(static_cast<std::size_t>(cells), 0);
-  voxelise(mesh);
+  SampleHeights heights;
+  voxelise(mesh, heights);
   find_support();
+  find_clearance(heights);
   start_voxel_ = find_start(start);
   flood_fill();
   find_floors();
@@ -49,8 +54,19 @@ GroundTruth::GroundTruth(const Mesh& mesh, const std::optional<StartPose>& start
 // Dense surface sampling: every triangle is sampled on a grid with spacing <= res/2 along the two
 // edges that meet at its largest angle, so every voxel the surface crosses gets a sample (up to
 // slivers at voxel corners, irrelevant for coverage with 1-voxel tolerance).
-void GroundTruth::voxelise(const Mesh& mesh) {
+void GroundTruth::voxelise(const Mesh& mesh, SampleHeights& heights) {
   const double r = opt_.resolution, h = 0.5 * r;
+  heights.lo.assign(grid_.size(), 255);
+  heights.hi.assign(grid_.size(), 0);
+  auto mark = [&](const Eigen::Vector3d& p, uint8_t f) {
+    const VoxelKey k = voxel_key(p, r);
+    if (!inside(k)) return;
+    const std::size_t i = index(k);
+    grid_[i] |= f;
+    const long q = std::clamp(std::lround((p.z() / r - k.z) * 255.0), 0L, 255L);
+    heights.lo[i] = std::min(heights.lo[i], static_cast<uint8_t>(q));
+    heights.hi[i] = std::max(heights.hi[i], static_cast<uint8_t>(q));
+  };
   const double min_nz = std::cos(opt_.max_slope_deg * M_PI / 180.0);
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
     const auto& tri = mesh.triangles[t];
@@ -74,14 +90,10 @@ void GroundTruth::voxelise(const Mesh& mesh) {
       const double u = double(i) / n1;
       const int jmax = static_cast<int>(std::floor((1.0 - u) * n2 + 1e-9));
       for (int j = 0; j <= jmax; ++j) {
-        const Eigen::Vector3d p = o + u * e1 + (double(j) / n2) * e2;
-        const VoxelKey k = voxel_key(p, r);
-        if (inside(k)) grid_[index(k)] |= f;
+        mark(o + u * e1 + (double(j) / n2) * e2, f);
       }
       // The far edge point for this row, so the edge opposite `o` is sampled too.
-      const Eigen::Vector3d p = o + u * e1 + (1.0 - u) * e2;
-      const VoxelKey k = voxel_key(p, r);
-      if (inside(k)) grid_[index(k)] |= f;
+      mark(o + u * e1 + (1.0 - u) * e2, f);
     }
   }
   occupied_count_ = 0;
@@ -101,14 +113,52 @@ void GroundTruth::find_support() {
     }
 }
 
+// Horizontal clearance, mirroring R_col of the map (core/map/terrain_analysis.cpp, paper III-A
+// Eq. 3): support voxel v is blocked when a voxel in the disc of ceil(collision_radius / res)
+// voxels around its column, from v's level up to the body clearance + 1 voxel, holds surface
+// geometry higher than step_height and no higher than body_clearance above v's support surface.
+// The map compares one surface height per voxel (its points' mean); the truth uses the sample
+// range of the voxel, so a wall is caught where its geometry enters that band, and the next stair
+// tread (0.167 m up, below the step height) is not an obstacle.
+void GroundTruth::find_clearance(const SampleHeights& h) {
+  const double r = opt_.resolution;
+  const int rc = static_cast<int>(std::ceil(opt_.collision_radius / r - 1e-9));
+  const int hc = static_cast<int>(std::ceil(opt_.body_clearance / r - 1e-9));
+  const double step = opt_.step_height / r, clear = opt_.body_clearance / r;  // in voxels
+  const std::size_t layer = std::size_t(nx_) * ny_;
+  for (int z = 0; z < nz_; ++z)
+    for (int y = 0; y < ny_; ++y)
+      for (int x = 0; x < nx_; ++x) {
+        const std::size_t i = z * layer + std::size_t(y) * nx_ + x;
+        if (!(grid_[i] & kSupport)) continue;
+        const double hv = z + h.hi[i] / 255.0;  // support surface [voxels]
+        bool hit = false;
+        for (int dy = -rc; dy <= rc && !hit; ++dy)
+          for (int dx = -rc; dx <= rc && !hit; ++dx) {
+            if (dx * dx + dy * dy > rc * rc) continue;
+            const int cx = x + dx, cy = y + dy;
+            if (cx < 0 || cy < 0 || cx >= nx_ || cy >= ny_) continue;
+            for (int dz = 0; dz <= hc + 1 && z + dz < nz_ && !hit; ++dz) {
+              const std::size_t j = (z + dz) * layer + std::size_t(cy) * nx_ + cx;
+              if (!(grid_[j] & kOccupied)) continue;
+              const double lo = z + dz + h.lo[j] / 255.0, hi = z + dz + h.hi[j] / 255.0;
+              hit = hi > hv + step && lo <= hv + clear;
+            }
+          }
+        if (!hit) grid_[i] |= kClear;
+      }
+}
+
 VoxelKey GroundTruth::find_start(const std::optional<StartPose>& start) {
   const double r = opt_.resolution;
   const std::size_t layer = std::size_t(nx_) * ny_;
   if (start) {
     start_ = *start;
     const VoxelKey c = voxel_key({start->x, start->y, start->z}, r);
-    // Nearest support voxel in height (within 0.5 m) in the column, then in growing rings.
-    for (int rad = 0; rad <= 5; ++rad) {
+    // Nearest support voxel with clearance in height (within 0.5 m) in the column, then in
+    // growing rings up to 1 m (the map seeds C_reach likewise, map.seed_search_radius_m).
+    const int rings = static_cast<int>(std::ceil(1.0 / r - 1e-9));
+    for (int rad = 0; rad <= rings; ++rad) {
       std::optional<VoxelKey> best;
       double best_d = 1e9;
       for (int dy = -rad; dy <= rad; ++dy)
@@ -116,16 +166,17 @@ VoxelKey GroundTruth::find_start(const std::optional<StartPose>& start) {
           if (std::max(std::abs(dx), std::abs(dy)) != rad) continue;
           for (int dz = -5; dz <= 5; ++dz) {
             const VoxelKey k{c.x + dx, c.y + dy, c.z + dz};
-            if (!support(k)) continue;
+            if (!clear(k)) continue;
             const double d = std::abs(dz) + 0.1 * (std::abs(dx) + std::abs(dy));
             if (d < best_d) best_d = d, best = k;
           }
         }
       if (best) return *best;
     }
-    throw std::runtime_error("ground truth: no walkable support within 0.5 m of the start (" +
-                             std::to_string(start->x) + ", " + std::to_string(start->y) + ", " +
-                             std::to_string(start->z) + ")");
+    throw std::runtime_error(
+        "ground truth: no walkable support with clearance within 1 m of the start (" +
+        std::to_string(start->x) + ", " + std::to_string(start->y) + ", " +
+        std::to_string(start->z) + ")");
   }
   // No start given: lowest height level with floor_min_area of support; its voxel nearest the
   // level's centroid whose 5x5 neighbourhood is all support at the same height.
@@ -141,7 +192,7 @@ VoxelKey GroundTruth::find_start(const std::optional<StartPose>& start) {
     for (std::size_t xy = 0; xy < layer; ++xy) {
       const int x = int(xy % nx_), y = int(xy / nx_);
       const VoxelKey k{min_.x + x, min_.y + y, min_.z + z};
-      if (!support(k)) continue;
+      if (!clear(k)) continue;
       bool flat = true;
       for (int dy = -2; dy <= 2 && flat; ++dy)
         for (int dx = -2; dx <= 2 && flat; ++dx) flat = support({k.x + dx, k.y + dy, k.z});
@@ -156,8 +207,9 @@ VoxelKey GroundTruth::find_start(const std::optional<StartPose>& start) {
   throw std::runtime_error("ground truth: no floor-sized walkable support in the mesh");
 }
 
-// Region growing over support voxels (paper III-A: reachable set C_reach from the robot's
-// support voxel): 8-neighbours horizontally, height change <= step height.
+// Region growing over support voxels with clearance (paper III-A: reachable set C_reach from
+// the robot's support voxel over traversable voxels): 8-neighbours horizontally, height change
+// <= step height.
 void GroundTruth::flood_fill() {
   const int max_dz = static_cast<int>(std::ceil(opt_.step_height / opt_.resolution - 1e-9));
   std::deque<VoxelKey> open = {start_voxel_};
@@ -174,7 +226,7 @@ void GroundTruth::flood_fill() {
           const VoxelKey n{k.x + dx, k.y + dy, k.z + dz};
           if (!inside(n)) continue;
           uint8_t& c = grid_[index(n)];
-          if ((c & kSupport) && !(c & kReachable)) {
+          if ((c & (kSupport | kClear)) == (kSupport | kClear) && !(c & kReachable)) {
             c |= kReachable;
             open.push_back(n);
           }

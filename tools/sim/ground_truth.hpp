@@ -34,8 +34,13 @@ struct GroundTruthOptions {
   double resolution = 0.1;       // [m], the map's voxel size (DESIGN §4)
   double body_clearance = 0.45;  // [m] free space above support: Go2 body 0.40 m + margin
   double step_height = 0.18;     // [m] largest step between neighbouring support voxels
-  double max_slope_deg = 30.0;   // [deg] steepest walkable surface (triangle normal)
-  double floor_min_area = 8.0;   // [m^2] a support height with less area is not a floor
+  // [m] horizontal clearance: the map's R_col (map.collision_radius_m, paper III-A Eq. 3). A
+  // support voxel is traversable truth only if no occupied voxel whose geometry reaches into
+  // (step_height, body_clearance] above the support surface lies within this horizontal radius
+  // (in voxels ceil(r / resolution), disc dx^2 + dy^2 <= r^2 as in core/map). 0: no clearance.
+  double collision_radius = 0.1;
+  double max_slope_deg = 30.0;  // [deg] steepest walkable surface (triangle normal)
+  double floor_min_area = 8.0;  // [m^2] a support height with less area is not a floor
 };
 
 struct FloorTruth {
@@ -61,6 +66,9 @@ class GroundTruth {
   bool occupied(const VoxelKey& k) const { return flag(k, kOccupied); }
   bool support(const VoxelKey& k) const { return flag(k, kSupport); }      // any support voxel
   bool reachable(const VoxelKey& k) const { return flag(k, kReachable); }  // traversable truth
+  // Support voxel with horizontal clearance (no obstacle within collision_radius), reachable
+  // or not.
+  bool clear(const VoxelKey& k) const { return flag(k, kSupport) && flag(k, kClear); }
   const std::vector<VoxelKey>& reachable_voxels() const { return reachable_; }
   std::size_t occupied_count() const { return occupied_count_; }
 
@@ -80,7 +88,7 @@ class GroundTruth {
   std::string describe_json(const std::string& scene_name) const;
 
  private:
-  static constexpr uint8_t kOccupied = 1, kWalkable = 2, kSupport = 4, kReachable = 8;
+  static constexpr uint8_t kOccupied = 1, kWalkable = 2, kSupport = 4, kReachable = 8, kClear = 16;
   bool inside(const VoxelKey& k) const {
     return k.x >= min_.x && k.y >= min_.y && k.z >= min_.z && k.x < min_.x + nx_ &&
            k.y < min_.y + ny_ && k.z < min_.z + nz_;
@@ -89,8 +97,14 @@ class GroundTruth {
     return (static_cast<std::size_t>(k.z - min_.z) * ny_ + (k.y - min_.y)) * nx_ + (k.x - min_.x);
   }
   bool flag(const VoxelKey& k, uint8_t f) const { return inside(k) && (grid_[index(k)] & f); }
-  void voxelise(const Mesh& mesh);
+  // Per-voxel lowest / highest surface sample inside the voxel, in 1/255 of a voxel above its
+  // bottom face (only meaningful for occupied voxels); used during construction only.
+  struct SampleHeights {
+    std::vector<uint8_t> lo, hi;
+  };
+  void voxelise(const Mesh& mesh, SampleHeights& h);
   void find_support();
+  void find_clearance(const SampleHeights& h);
   VoxelKey find_start(const std::optional<StartPose>& start);
   void flood_fill();
   void find_floors();

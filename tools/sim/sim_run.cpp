@@ -276,6 +276,8 @@ SimRunResult run_exploration(const SimRunOptions& opt) {
   go.resolution = params.map.voxel_size_m;
   go.step_height = params.robot.step_height_m;
   go.max_slope_deg = params.robot.max_slope_rad * 180.0 / M_PI;
+  go.body_clearance = params.robot.body_height_m + params.robot.body_margin_m;
+  go.collision_radius = params.map.collision_radius_m;  // truth mirrors the map's R_col
   const GroundTruth gt(scene.mesh, scene.start, go);
 
   SimOptions so;
