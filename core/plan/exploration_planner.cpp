@@ -201,6 +201,7 @@ ExplorationResult ExplorationPlanner::plan_cycle(const ExplorationInput& in) {
       probe_mark(probe_, PlanStage::kGlobal);
       const GlobalPlan gp = global_.plan(hybrid_, robot_node, aside);
       r.zone_sequence = gp.zone_order;
+      r.zones_deferred = gp.deferred;
       zones_left = !gp.zone_order.empty();
       if (zones_left) {
         r.guided = true;

@@ -76,7 +76,8 @@ struct ExplorationResult {
   double dz_m = 0;
   // Debug (pictures): zones, global sequence, local order. Hybrid nodes/edges: hybrid().
   std::vector<ZoneSummary> zones;
-  std::vector<int32_t> zone_sequence;  // global TSP order (zone ids)
+  std::vector<int32_t> zone_sequence;  // global TSP order (zone ids), nearest zones only
+  int zones_deferred = 0;              // reachable uncompleted zones left out of this cycle's TSP
   std::vector<int32_t> cluster_order;  // Stage 1 order (cluster ids)
   bool guided = false;                 // macro guidance was used this cycle
   MaintenanceStats maintenance;

@@ -23,31 +23,45 @@ GlobalPlan GlobalPlanner::solve(const HybridGraph& hg, uint32_t robot_node) {
     bool missing = false;
     for (double c : out_row) missing = missing || c == kUnreachable;
     if (!missing) return false;
-    std::vector<double> hybrid(targets_.size());
-    search_.costs_from(g, from, targets_, hybrid, AllEdges{});
+    hybrid_row_.resize(targets_.size());
+    search_.costs_from(g, from, targets_, hybrid_row_, AllEdges{});
     for (size_t i = 0; i < out_row.size(); ++i)
-      if (out_row[i] == kUnreachable) out_row[i] = hybrid[i];
+      if (out_row[i] == kUnreachable) out_row[i] = hybrid_row_[i];
     return true;
   };
   out.hybrid_rows += two_stage_row(robot_node, row_);
-  size_t k = 0;
-  for (size_t i = 0; i < targets_.size(); ++i) {
-    if (row_[i] == kUnreachable) {
-      ++out.unreachable;
-      continue;
-    }
-    zone_ids_[k] = zone_ids_[i];
-    targets_[k] = targets_[i];
-    ++k;
+  for (double c : row_) out.unreachable += c == kUnreachable;
+  // The max_zones_ nearest reachable zones (ties: list order, i.e. zone id) enter the TSP; kept
+  // in list order so the matrix does not depend on the ranking.
+  by_cost_.clear();
+  for (size_t i = 0; i < targets_.size(); ++i)
+    if (row_[i] != kUnreachable) by_cost_.push_back(i);
+  if (by_cost_.size() > size_t(max_zones_)) {
+    std::stable_sort(by_cost_.begin(), by_cost_.end(),
+                     [&](size_t a, size_t b) { return row_[a] < row_[b]; });
+    out.deferred = int(by_cost_.size()) - max_zones_;
+    by_cost_.resize(size_t(max_zones_));
+    std::sort(by_cost_.begin(), by_cost_.end());
+  }
+  const size_t k = by_cost_.size();
+  for (size_t j = 0; j < k; ++j) {
+    const size_t i = by_cost_[j];
+    zone_ids_[j] = zone_ids_[i];
+    targets_[j] = targets_[i];
+    row_[j] = row_[i];
   }
   zone_ids_.resize(k);
   targets_.resize(k);
+  row_.resize(k);
   const int n = int(k) + 1;  // index 0 = robot
   costs_.assign(size_t(n) * size_t(n), 0.0);
   std::vector<double> r(k);
   for (int i = 0; i < n; ++i) {
-    const uint32_t from = i == 0 ? robot_node : targets_[size_t(i - 1)];
-    out.hybrid_rows += two_stage_row(from, r);
+    if (i == 0) {
+      r = row_;  // the robot's row is the one computed above
+    } else {
+      out.hybrid_rows += two_stage_row(targets_[size_t(i - 1)], r);
+    }
     for (size_t j = 0; j < k; ++j) costs_[size_t(i) * size_t(n) + j + 1] = r[j];
     costs_[size_t(i) * size_t(n)] = kUnreachable;  // open tour: never return to the robot
   }

@@ -5,7 +5,12 @@
 // Rows of D come from one Dijkstra per centre with the real-only filter, plus one over the
 // hybrid graph for the centres the first could not reach (same result as a two-stage A* per
 // pair, 2 searches per row instead of 2 per pair). Zones no route reaches are left out and
-// reported. Execution toward a zone follows only the real prefix of its path (approach()).
+// reported. Bounded work: only the max_tsp_zones zones nearest the robot (two-stage cost) enter
+// the TSP, the rest wait for a later cycle (as the local layer's max_tsp_clusters): the local
+// layer only serves the first guidance_zones of the sequence, and a building-size prior holds
+// ~100 zones (one row = one Dijkstra over the whole hybrid graph). Execution toward a zone
+// follows only the real prefix of its path (approach()).
+#include <algorithm>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -24,6 +29,7 @@ struct GlobalPlan {
   double cost = 0;                  // tour cost [m]
   int unreachable = 0;              // uncompleted zones no route reaches (left out)
   int hybrid_rows = 0;              // rows that needed the hybrid stage
+  int deferred = 0;                 // reachable zones beyond max_tsp_zones (not in zone_order)
 };
 
 struct Approach {
@@ -36,7 +42,10 @@ struct Approach {
 
 class GlobalPlanner {
  public:
-  explicit GlobalPlanner(const TspOptions& tsp = {}) : tsp_(tsp) {}
+  // max_tsp_zones: zones entering the TSP (nearest first), >= 1.
+  explicit GlobalPlanner(const TspOptions& tsp = {}, int max_tsp_zones = kDefaultMaxTspZones)
+      : tsp_(tsp), max_zones_(std::max(1, max_tsp_zones)) {}
+  static constexpr int kDefaultMaxTspZones = 16;
   // excluded(zone id) -> true: leave the zone out (e.g. the robot could not approach it).
   template <class Excluded>
   GlobalPlan plan(const HybridGraph& hg, uint32_t robot_node, Excluded&& excluded);
@@ -46,10 +55,12 @@ class GlobalPlanner {
  private:
   GlobalPlan solve(const HybridGraph& hg, uint32_t robot_node);
   TspSolver tsp_;
+  int max_zones_;
   GraphSearch search_;
   std::vector<int32_t> zone_ids_;
   std::vector<uint32_t> targets_;
-  std::vector<double> costs_, row_;
+  std::vector<double> costs_, row_, hybrid_row_;
+  std::vector<size_t> by_cost_;
 };
 
 template <class Excluded>

@@ -141,6 +141,7 @@ class GraphSearch {
 
   std::vector<double> dist_;
   std::vector<uint32_t> pred_, stamp_, closed_;
+  std::vector<std::pair<uint32_t, uint32_t>> target_;  // (generation, multiplicity) of stop_at
   std::vector<HeapItem> heap_;
   std::vector<Settled> settled_;
   uint32_t gen_ = 0;
@@ -167,6 +168,7 @@ inline void GraphSearch::reset(size_t n) {
   if (++gen_ == 0) {  // wrapped: clear stamps once every 2^32 searches
     std::fill(stamp_.begin(), stamp_.end(), 0);
     std::fill(closed_.begin(), closed_.end(), 0);
+    std::fill(target_.begin(), target_.end(), std::pair<uint32_t, uint32_t>{0, 0});
     gen_ = 1;
   }
   heap_.clear();
@@ -244,8 +246,16 @@ std::span<const Settled> GraphSearch::dijkstra(const Adj& g, std::span<const uin
     pred_[s] = kNoNode;
     push(0, s);
   }
+  // Targets are marked (target_[t] == gen_, with their multiplicity) so settling a node costs
+  // O(1) instead of a pass over stop_at (the global planner passes ~100 zone centres).
   size_t remaining = 0;
-  for (uint32_t t : stop_at) remaining += t < n;  // a duplicate is counted and settled twice
+  if (target_.size() < n) target_.resize(n, {0, 0});
+  for (uint32_t t : stop_at) {
+    if (t >= n) continue;
+    if (target_[t].first != gen_) target_[t] = {gen_, 0};
+    ++target_[t].second;  // a duplicate is counted and settled twice
+    ++remaining;
+  }
   while (!heap_.empty()) {
     const HeapItem top = pop();
     const uint32_t u = top.node;
@@ -253,8 +263,8 @@ std::span<const Settled> GraphSearch::dijkstra(const Adj& g, std::span<const uin
     if (top.key > radius_m) break;
     closed_[u] = gen_;
     settled_.push_back({u, dist_[u], pred_[u]});
-    if (!stop_at.empty()) {
-      for (uint32_t t : stop_at) remaining -= (t == u);
+    if (!stop_at.empty() && target_[u].first == gen_) {
+      remaining -= target_[u].second;
       if (remaining == 0) break;
     }
     const double du = dist_[u];

@@ -163,4 +163,27 @@ TEST(GlobalPlanner, VisitsTheNearerHypotheticalZoneFirst) {
   EXPECT_TRUE(a.used_hybrid);
   EXPECT_LT(a.real_prefix, a.path.size());
   EXPECT_LT(a.goal_m.x(), 6.6);
+
+  // Bounded TSP: with room for one zone only the nearest one enters, the rest are deferred.
+  GlobalPlanner one(TspOptions{}, 1);
+  const GlobalPlan p1 = one.plan(hg, robot, [](int32_t) { return false; });
+  ASSERT_TRUE(p1.ok);
+  ASSERT_EQ(p1.zone_order.size(), 1u);
+  EXPECT_EQ(p1.deferred, int(plan.zone_order.size()) - 1);
+  double nearest = kUnreachable;
+  int32_t nearest_id = -1;
+  for (int32_t id : plan.zone_order)
+    for (const HybridZone& z : hg.zones())
+      if (z.id == id) {
+        const Approach za = gp.approach(hg, robot, z.centre);
+        ASSERT_TRUE(za.ok);
+        double len = 0;  // the two-stage cost: real path if any, else the hybrid one
+        for (size_t i = 1; i < za.path.size(); ++i)
+          len += (hg.nodes()[za.path[i]].p_m - hg.nodes()[za.path[i - 1]].p_m).norm();
+        if (len < nearest) nearest = len, nearest_id = id;
+      }
+  EXPECT_EQ(p1.zone_order.front(), nearest_id);
+  // With room for every zone the order is the unbounded one.
+  GlobalPlanner all(TspOptions{}, 100);
+  EXPECT_EQ(all.plan(hg, robot, [](int32_t) { return false; }).zone_order, plan.zone_order);
 }
