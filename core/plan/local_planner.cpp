@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 
 #include "core/plan/plan_config.hpp"
@@ -61,10 +62,58 @@ const SetAsideEntry* LocalPlanner::set_aside_at(const Eigen::Vector3f& p) const 
   return nullptr;
 }
 
-void LocalPlanner::set_aside_cluster(const graph::ReachableGraph& g,
-                                     const graph::FrontierCluster& c, double t_s,
+uint16_t frontier_signature(const graph::GraphNode& n) {
+  return uint16_t(n.c_sur | (n.c_exp << 1) | (n.boundary << 2) | (uint16_t(n.open_dirs) << 3));
+}
+
+void LocalPlanner::set_aside_cluster(const LocalPlanInput& in, const graph::FrontierCluster& c,
                                      SetAsideReason reason) {
-  for (graph::NodeId n : c.nodes) set_aside_.push_back({g.node(n).p_m, t_s, c.id, reason});
+  const graph::ReachableGraph& g = *in.graph;
+  for (graph::NodeId n : c.nodes)
+    set_aside_.push_back({g.node(n).p_m, in.t_s, c.id, reason, in.robot_foot_m.cast<float>(),
+                          frontier_signature(g.node(n))});
+}
+
+// A set-aside node means "not resolvable from where the robot can stand, on the map as it was
+// then". It expires when that premise may no longer hold:
+//  1) the map near it changed: no live node within set_aside_radius_m any more, or the nearest
+//     one moved, is no frontier, or has other frontier flags than then (TopologicalFrontiers
+//     recomputes them where the map changed);
+//  2) set_aside_expiry_s passed and the robot is more than set_aside_expiry_move_m from where it
+//     stood then: another vantage point may resolve it.
+// Only inputs decide (t_s is the input's time base, no clock), so replays repeat it.
+int LocalPlanner::expire_set_aside(const LocalPlanInput& in) {
+  constexpr float kMovedM = 0.05f;  // a node this far from its recorded position was re-sampled
+  const graph::ReachableGraph& g = *in.graph;
+  const Eigen::Vector3f robot = in.robot_foot_m.cast<float>();
+  const float r = float(opt_.set_aside_radius_m);
+  const float move2 = float(opt_.set_aside_expiry_move_m * opt_.set_aside_expiry_move_m);
+  size_t kept = 0;
+  for (size_t i = 0; i < set_aside_.size(); ++i) {
+    const SetAsideEntry& e = set_aside_[i];
+    near_scratch_.clear();
+    g.nodes_within(e.p_m, r, 0.5f, near_scratch_);
+    graph::NodeId best = graph::kNoId;
+    float best_d = std::numeric_limits<float>::infinity();
+    for (graph::NodeId n : near_scratch_) {
+      if (!g.node(n).alive) continue;
+      const float d = (g.node(n).p_m - e.p_m).squaredNorm();
+      if (d < best_d || (d == best_d && n < best)) best_d = d, best = n;
+    }
+    bool expire = best == graph::kNoId;
+    if (!expire) {
+      const graph::GraphNode& gn = g.node(best);
+      expire =
+          !gn.frontier() || frontier_signature(gn) != e.frontier_sig || best_d > kMovedM * kMovedM;
+    }
+    expire = expire || (in.t_s - e.t_s >= opt_.set_aside_expiry_s &&
+                        (robot - e.robot_m).head<2>().squaredNorm() > move2);
+    if (!expire) set_aside_[kept++] = e;
+  }
+  const int n = int(set_aside_.size() - kept);
+  set_aside_.resize(kept);
+  expired_total_ += uint64_t(n);
+  return n;
 }
 
 const graph::FrontierCluster* LocalPlanner::find_cluster(const LocalPlanInput& in,
@@ -231,11 +280,12 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   }
   const graph::ReachableGraph& g = *in.graph;
   out.clusters_total = int(in.clusters->size());
+  out.set_aside_expired = expire_set_aside(in);
 
   // ---- Keep the current target unless there is a reason to replan.
+  probe_mark(probe_, PlanStage::kLocalKeep);
   const char* reason = "no target";
   if (has_target_) {
-  probe_mark(probe_, PlanStage::kLocalKeep);
     const graph::FrontierCluster* tc = find_cluster(in, target_cluster_);
     const double dxy = (in.robot_foot_m - target_m_).head<2>().norm();
     const bool reached =
@@ -250,8 +300,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
             std::find(approached_.begin(), approached_.end(), target_cluster_) != approached_.end();
         if (approached || !reached) {
           set_aside_cluster(
-              g, *tc, in.t_s,
-              reached ? SetAsideReason::kStillFrontierAtTarget : SetAsideReason::kOverdue);
+              in, *tc, reached ? SetAsideReason::kStillFrontierAtTarget : SetAsideReason::kOverdue);
         } else {
           approached_.push_back(target_cluster_);
         }
@@ -289,9 +338,9 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   out.replan_reason = reason;
 
   // ---- Stage 1: TSP over the cluster representatives (graph path costs).
+  probe_mark(probe_, PlanStage::kLocalStage1);
   if (in.clusters->empty()) {
     out.status = LocalPlanStatus::kNoFrontiers;
-  probe_mark(probe_, PlanStage::kLocalStage1);
     return out;
   }
   build_search_graph(g);
@@ -378,9 +427,9 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   for (size_t k : order) out.cluster_order.push_back(sel[k].cluster_id);
 
   // ---- Stage 2: one viewpoint per cluster over the window W (Eq. 6).
+  probe_mark(probe_, PlanStage::kLocalStage2);
   auto viewpoints_of = [&](const Candidate& c) {
     std::vector<Viewpoint> v;
-  probe_mark(probe_, PlanStage::kLocalStage2);
     for (const auto& cv : *in.viewpoints) {
       if (cv.cluster_id != c.cluster_id) continue;
       for (const auto& gv : cv.viewpoints) {
@@ -423,9 +472,9 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
 
   // ---- Stage 3: voxel A* + B-spline to the first viewpoint; on failure the cluster's other
   // candidates, then the next clusters (bounded).
+  probe_mark(probe_, PlanStage::kLocalStage3);
   if (!free_start(in)) {  // boxed in on the map: no cluster is to blame
     out.status = LocalPlanStatus::kStartBlocked;
-  probe_mark(probe_, PlanStage::kLocalStage3);
     return out;
   }
   int attempts = 0;
@@ -472,7 +521,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
                            [&](const auto& f) { return f.first == c.cluster_id; });
     if (it == failures_.end()) it = failures_.insert(failures_.end(), {c.cluster_id, 0});
     if (++it->second >= opt_.max_failures) {
-      set_aside_cluster(g, (*in.clusters)[c.cluster_index], in.t_s, why);
+      set_aside_cluster(in, (*in.clusters)[c.cluster_index], why);
       failures_.erase(it);
     }
   }

@@ -10,7 +10,10 @@
 // the target is reached, the rest of the trajectory collides on the new map, or replan_period_s
 // passed. Frontier nodes that stay frontiers after the robot stood at their viewpoint, or whose
 // cluster repeatedly fails Stage 3, are set aside (they are not observable from where the robot
-// can stand), so exploration ends when no reachable, observable frontier is left.
+// can stand), so exploration ends when no reachable, observable frontier is left. A set-aside
+// node expires when the map near it changes (its frontier flags or position differ, or it is
+// gone) or, after set_aside_expiry_s, once the robot stands set_aside_expiry_move_m away from
+// where it was then (a new vantage point); see expire_set_aside().
 //
 // Single-threaded: the firmware's plan task owns it. The macro layer (ExplorationPlanner) can
 // replace or wrap it: the interface is the one plan(input) -> result call.
@@ -69,6 +72,7 @@ struct LocalPlanResult {
   std::vector<int32_t> cluster_order;   // Stage 1 order (cluster ids)
   std::vector<Eigen::Vector3d> path_m;  // Stage 3 A* path (support points)
   int clusters_total = 0, clusters_set_aside = 0, clusters_unreachable = 0;
+  int set_aside_expired = 0;  // set-aside nodes that expired this cycle
   uint32_t astar_calls = 0;
   uint32_t graph_fallbacks = 0;  // Stage 3 paths taken along G_real (voxel A* failed)
 };
@@ -87,17 +91,24 @@ struct SetAsideEntry {
   double t_s = 0;                                 // when
   int32_t cluster_id = -1;
   SetAsideReason reason = SetAsideReason::kStillFrontierAtTarget;
+  Eigen::Vector3f robot_m = Eigen::Vector3f::Zero();  // robot foot point then
+  uint16_t frontier_sig = 0;  // the node's frontier flags then (frontier_signature())
 };
+// C_sur, C_exp, boundary and |Theta_open| of a node packed: what TopologicalFrontiers
+// recomputes when the map near the node changes.
+uint16_t frontier_signature(const graph::GraphNode& n);
 
 struct LocalPlannerOptions {
-  int max_tsp_clusters = 12;          // nearest clusters (graph distance) entering Stage 1
-  double replan_period_s = 4.0;       // re-optimise a kept target this often
-  double reached_radius_m = 0.5;      // robot this close to the viewpoint = reached
-  double set_aside_radius_m = 0.3;    // a frontier node this close to a set-aside one is ignored
-  int max_failures = 2;               // Stage 3 failures before a cluster is set aside
-  int max_stage3_attempts = 6;        // viewpoints tried per cycle (bounded work)
-  double escape_radius_m = 0.3;       // start pose in collision: free start searched this far
-  double escape_turn_radius_m = 0.8;  // cannot turn on the spot: a turning place this far
+  int max_tsp_clusters = 12;             // nearest clusters (graph distance) entering Stage 1
+  double replan_period_s = 4.0;          // re-optimise a kept target this often
+  double reached_radius_m = 0.5;         // robot this close to the viewpoint = reached
+  double set_aside_radius_m = 0.3;       // a frontier node this close to a set-aside one is ignored
+  int max_failures = 2;                  // Stage 3 failures before a cluster is set aside
+  int max_stage3_attempts = 6;           // viewpoints tried per cycle (bounded work)
+  double escape_radius_m = 0.3;          // start pose in collision: free start searched this far
+  double escape_turn_radius_m = 0.8;     // cannot turn on the spot: a turning place this far
+  double set_aside_expiry_s = 30.0;      // a set-aside node may expire after this [s] ...
+  double set_aside_expiry_move_m = 2.0;  // ... once the robot is this far from where it was
 };
 
 class LocalPlanner {
@@ -109,6 +120,7 @@ class LocalPlanner {
   void drop_target() { has_target_ = false; }
   bool has_target() const { return has_target_; }
   size_t set_aside_nodes() const { return set_aside_.size(); }
+  uint64_t set_aside_expired() const { return expired_total_; }  // since construction
   // Diagnostics: the set-aside frontier nodes with their reasons; the entry of the set-aside
   // node nearest p (within set_aside_radius_m), or nullptr.
   const std::vector<SetAsideEntry>& set_aside() const { return set_aside_; }
@@ -122,8 +134,9 @@ class LocalPlanner {
     uint32_t rep;  // representative node (nearest the centroid)
   };
   bool ignored(const Eigen::Vector3f& p) const { return set_aside_at(p) != nullptr; }
-  void set_aside_cluster(const graph::ReachableGraph& g, const graph::FrontierCluster& c,
-                         double t_s, SetAsideReason reason);
+  void set_aside_cluster(const LocalPlanInput& in, const graph::FrontierCluster& c,
+                         SetAsideReason reason);
+  int expire_set_aside(const LocalPlanInput& in);
   const graph::FrontierCluster* find_cluster(const LocalPlanInput& in, int32_t id) const;
   void build_search_graph(const graph::ReachableGraph& g);
   // Stage 3 to one viewpoint; on failure *why says A* or trajectory.
@@ -159,6 +172,8 @@ class LocalPlanner {
   double planned_at_s_ = 0;
   // Frontier nodes set aside (positions: node ids are recycled) and Stage 3 failures per cluster.
   std::vector<SetAsideEntry> set_aside_;
+  uint64_t expired_total_ = 0;
+  std::vector<graph::NodeId> near_scratch_;
   std::vector<std::pair<int32_t, int>> failures_;
   std::vector<int32_t>
       approached_;  // clusters whose viewpoint was reached once (walk onto them next)

@@ -1,0 +1,136 @@
+// LocalPlanner's set-aside frontier nodes (issue 9 diagnostics): they expire when the map near
+// them changes, or after a while once the robot has moved; never on an unchanged map with the
+// robot standing still.
+#include "core/plan/local_planner.hpp"
+
+#include <gtest/gtest.h>
+
+#include "macro_world.hpp"
+
+using namespace storey::core::plan;
+using storey::core::RobotModel;
+using storey::test::macro::Harness;
+using storey::test::macro::World;
+
+namespace {
+
+// A 40 m corridor (6 m wide): one scan from the middle leaves a frontier at each open end.
+World corridor() {
+  World w;
+  w.add({-20, -3, -0.2f}, {20, 3, 0});
+  w.add({-20, -3.2f, 0}, {20, -3, 2.5f});
+  w.add({-20, 3, 0}, {20, 3.2f, 2.5f});
+  return w;
+}
+
+LocalPlanInput input(const Harness& h, const storey::core::map::MapView& view,
+                     const Eigen::Vector3f& foot, double t) {
+  LocalPlanInput in;
+  in.view = &view;
+  in.graph = &h.graph;
+  in.clusters = &h.clusters.clusters();
+  in.viewpoints = &h.viewpoints.viewpoints();
+  in.robot_foot_m = foot.cast<double>();
+  in.t_s = t;
+  return in;
+}
+
+// Plans to a cluster, then lets the trajectory run late without the robot moving: the target
+// cluster is set aside (overdue). Returns the set-aside positions and the time.
+struct SetAside {
+  std::vector<Eigen::Vector3f> p;
+  double t = 0;
+};
+SetAside set_aside_one(LocalPlanner& lp, const Harness& h, const Eigen::Vector3f& foot) {
+  SetAside s;
+  const auto view = h.map.view();
+  const LocalPlanResult r0 = lp.plan(input(h, view, foot, 0.0));
+  EXPECT_EQ(r0.status, LocalPlanStatus::kNewTrajectory) << r0.replan_reason;
+  if (r0.status != LocalPlanStatus::kNewTrajectory) return s;
+  s.t = r0.trajectory.t_end() + 10.0;
+  lp.plan(input(h, view, foot, s.t));
+  for (const SetAsideEntry& e : lp.set_aside()) {
+    EXPECT_EQ(e.cluster_id, r0.target_cluster);
+    EXPECT_EQ(e.reason, SetAsideReason::kOverdue);
+    s.p.push_back(e.p_m);
+  }
+  EXPECT_FALSE(s.p.empty());
+  return s;
+}
+
+size_t still_set_aside(const LocalPlanner& lp, const SetAside& s) {
+  size_t n = 0;
+  for (const Eigen::Vector3f& p : s.p) n += lp.set_aside_at(p) != nullptr;
+  return n;
+}
+
+}  // namespace
+
+TEST(LocalPlanner, SetAsideStaysOnAnUnchangedMapAndExpiresWhereTheMapChanges) {
+  const World w = corridor();
+  Harness h;
+  const Eigen::Vector3f foot(0, 0, 0);
+  h.observe(w, foot, 40000, 1);
+  ASSERT_GE(h.clusters.clusters().size(), 2u);
+  LocalPlanner lp(RobotModel{}, PlanOptions{}, 0.1);
+  const SetAside s = set_aside_one(lp, h, foot);
+  ASSERT_FALSE(s.p.empty());
+
+  // Same map, robot still, long after: nothing expires.
+  {
+    const auto view = h.map.view();
+    lp.drop_target();
+    const LocalPlanResult r = lp.plan(input(h, view, foot, s.t + 1000.0));
+    EXPECT_EQ(r.set_aside_expired, 0);
+    EXPECT_EQ(still_set_aside(lp, s), s.p.size());
+  }
+
+  // The robot walks toward the set-aside frontier and scans it: the map there changes, the
+  // frontier flags of those nodes change (or they stop being frontiers): those entries expire.
+  Eigen::Vector3f c = Eigen::Vector3f::Zero();
+  for (const Eigen::Vector3f& p : s.p) c += p;
+  c /= float(s.p.size());
+  const Eigen::Vector3f foot2(c.x() > 0 ? c.x() - 3.f : c.x() + 3.f, 0, 0);
+  h.observe(w, foot2, 40000, 2);
+  const auto view = h.map.view();
+  lp.drop_target();
+  // 1 s later: too early for the time rule, so only the map change can expire them.
+  const LocalPlanResult r = lp.plan(input(h, view, foot, s.t + 1001.0));
+  EXPECT_GT(r.set_aside_expired, 0);
+  EXPECT_LT(still_set_aside(lp, s), s.p.size());
+  EXPECT_EQ(lp.set_aside_expired(), uint64_t(r.set_aside_expired));
+  // Whatever is still set aside has the frontier flags it had when it was set aside.
+  for (const SetAsideEntry& e : lp.set_aside()) {
+    const auto n = h.graph.nearest(e.p_m, 0.3f, 0.5f);
+    ASSERT_NE(n, storey::core::graph::kNoId);
+    EXPECT_EQ(frontier_signature(h.graph.node(n)), e.frontier_sig);
+  }
+}
+
+TEST(LocalPlanner, SetAsideExpiresAfterTheTimeoutOnlyOnceTheRobotMoved) {
+  const World w = corridor();
+  Harness h;
+  const Eigen::Vector3f foot(0, 0, 0);
+  h.observe(w, foot, 40000, 1);
+  LocalPlannerOptions o;
+  o.set_aside_expiry_s = 30.0;
+  o.set_aside_expiry_move_m = 2.0;
+  LocalPlanner lp(RobotModel{}, PlanOptions{}, 0.1, o);
+  const SetAside s = set_aside_one(lp, h, foot);
+  ASSERT_FALSE(s.p.empty());
+  const auto view = h.map.view();
+  const Eigen::Vector3f moved(0, 2.5f, 0);  // 2.5 m from where the robot stood
+  // Moved, but too early.
+  lp.drop_target();
+  EXPECT_EQ(lp.plan(input(h, view, moved, s.t + 29.0)).set_aside_expired, 0);
+  EXPECT_EQ(still_set_aside(lp, s), s.p.size());
+  // Late enough, but back where it stood (moved less than 2 m).
+  lp.drop_target();
+  EXPECT_EQ(lp.plan(input(h, view, Eigen::Vector3f(0, 1.5f, 0), s.t + 60.0)).set_aside_expired, 0);
+  EXPECT_EQ(still_set_aside(lp, s), s.p.size());
+  // Late enough and moved: expired (another vantage point may resolve them).
+  lp.drop_target();
+  const LocalPlanResult r = lp.plan(input(h, view, moved, s.t + 61.0));
+  EXPECT_EQ(r.set_aside_expired, int(s.p.size()));
+  EXPECT_EQ(still_set_aside(lp, s), 0u);
+}
