@@ -142,17 +142,21 @@ TEST(Results, MarkdownTablesShapedLikeThePapers) {
   ResultsInput in{fx.outcomes, "storey-eval --test", {{"two", "coverage_two.png"}}};
   const std::string md = results_markdown(in);
   // Table I: mean ± std over seeds; all floors explored in every seed.
-  EXPECT_NE(md.find("| two | storey | 3/3 | Yes | 1+2 | 530 ± 30 | 410 ± 10 | 250 ± 0 | 600 ± 0 | "
-                    "94.0 ± 0.0 | 0 / 0 |"),
-            std::string::npos)
+  EXPECT_NE(
+      md.find(
+          "| two | storey | 3/3 | Yes | 1+2 | done 3 | 530 ± 30 | 410 ± 10 | 250 ± 0 | 600 ± 0 | "
+          "94.0 ± 0.0 | 0 / 0 |"),
+      std::string::npos)
       << md;
   // All failed: n/a with the count, in every metric cell.
-  EXPECT_NE(md.find("| two | tare-like | 0/3 (3 failed) | n/a | n/a | n/a (3 of 3 failed) | n/a (3 "
-                    "of 3 failed) |"),
-            std::string::npos)
+  EXPECT_NE(
+      md.find("| two | tare-like | 0/3 (3 failed) | n/a | n/a | n/a | n/a (3 of 3 failed) | n/a (3 "
+              "of 3 failed) |"),
+      std::string::npos)
       << md;
   // One of three failed: the mean over the two finished; floors explored: the first only.
-  EXPECT_NE(md.find("| two | fael-like | 2/3 (1 failed) | No | 1 | 320 ± 28 |"), std::string::npos)
+  EXPECT_NE(md.find("| two | fael-like | 2/3 (1 failed) | No | 1 | done 2 | 320 ± 28 |"),
+            std::string::npos)
       << md;
   // Table II: floor 1 270 ± 10, floor 2 (from floor 1 done) 220 ± 10, reduction 1 - 220/270.
   EXPECT_NE(md.find("| two | 3/3 | 270.0 ± 10.0 | 220.0 ± 10.0 | 18.5 % | 95.0 ± 0.0 | 93.0 ± "

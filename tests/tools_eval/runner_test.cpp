@@ -158,3 +158,28 @@ TEST(Runner, FormatDuration) {
 
 }  // namespace
 }  // namespace storey::tools::eval
+
+namespace storey::tools::eval {
+namespace {
+
+TEST(RunRecord, LastSimulatedTimeReadsTheChildsProgressLines) {
+  const std::string dir = test::fresh_dir("simtime");
+  const std::string log = dir + "/log.txt";
+  EXPECT_DOUBLE_EQ(last_simulated_time(log), -1.0);  // no file yet
+  test::write_text(log, "storey sim: scene office, sensor vlp16, seed 1, time limit 60 s\n");
+  EXPECT_DOUBLE_EQ(last_simulated_time(log), -1.0);
+  std::string text = "storey sim: scene office\n";
+  for (int i = 1; i <= 400; ++i) {  // longer than the 4 KiB tail that is read
+    char b[128];
+    std::snprintf(b, sizeof b, "[sim %7.1f s] coverage %5.1f %%  floor 0  nodes 12\n", 5.0 * i,
+                  0.1 * i);
+    text += b;
+  }
+  test::write_text(log, text);
+  EXPECT_DOUBLE_EQ(last_simulated_time(log), 2000.0);
+  EXPECT_EQ(last_line(log).rfind("[sim  2000.0 s]", 0), 0u);
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace storey::tools::eval

@@ -46,9 +46,10 @@ TEST(EvalEndToEnd, RealRunsTablesAndResumption) {
   EXPECT_EQ(slurp(out + ".stdout"), out + "/results.md\n");
   const std::string md = slurp(out + "/results.md");
   EXPECT_NE(md.find("| test_box_room | storey | 2/2 |"), std::string::npos) << md;
-  EXPECT_NE(md.find("| test_box_room | no-such-method | 0/2 (2 failed) | n/a | n/a | n/a (2 of 2 "
-                    "failed) |"),
-            std::string::npos)
+  EXPECT_NE(
+      md.find("| test_box_room | no-such-method | 0/2 (2 failed) | n/a | n/a | n/a | n/a (2 of 2 "
+              "failed) |"),
+      std::string::npos)
       << md;
   EXPECT_NE(md.find("| test_box_room | no-such-method | 2 of 2 | storey sim: --method "
                     "no-such-method"),

@@ -106,6 +106,29 @@ std::string floors_text(const RunGroup& g) {
   return best + " (" + std::to_string(count[best]) + "/" + std::to_string(ms.size()) + ")";
 }
 
+// How the finished seeds ended: "done 3, limit 2" (exploration complete / time limit / other),
+// so a time column at the time limit is not read as a completion time.
+std::string end_text(const RunGroup& g) {
+  size_t done = 0, limit = 0, other = 0;
+  for (const RunOutcome* r : g.runs) {
+    if (r->status != RunStatus::finished) continue;
+    if (r->reason.rfind("exploration complete", 0) == 0)
+      ++done;
+    else if (r->reason.rfind("time limit", 0) == 0)
+      ++limit;
+    else
+      ++other;
+  }
+  std::string s;
+  auto add = [&](size_t n, const char* what) {
+    if (n) s += (s.empty() ? "" : ", ") + std::string(what) + " " + std::to_string(n);
+  };
+  add(done, "done");
+  add(limit, "limit");
+  add(other, "other");
+  return s.empty() ? "n/a" : s;
+}
+
 std::string safety_text(const RunGroup& g) {
   const auto ms = finished_metrics(g);
   if (ms.empty()) return "n/a";
@@ -242,17 +265,17 @@ std::string results_markdown(const ResultsInput& in) {
 
   // Table I: every scene x method without ablation.
   md << "## Table I: results in the multi-floor scenes\n\n"
-        "| Scene | Method | Runs | Succ. | Floors | Exp. time (s) | Traj. dist. (m) | "
+        "| Scene | Method | Runs | Succ. | Floors | End | Exp. time (s) | Traj. dist. (m) | "
         "Trav. vol. (m³) | Occ. vol. (m³) | Coverage (%) | Coll. / falls |\n"
-        "|---|---|---|---|---|---|---|---|---|---|---|\n";
+        "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   std::vector<std::string> truth_notes;
   for (const auto& g : groups) {
     if (!g.ablation.empty()) continue;
     md << "| " << g.scene << " | " << g.method << " | " << runs_text(g) << " | " << success_text(g)
-       << " | " << floors_text(g) << " | " << cell(g, stat_over(g, time_of), 0) << " | "
-       << cell(g, stat_over(g, dist_of), 0) << " | " << cell(g, stat_over(g, trav_of), 0) << " | "
-       << cell(g, stat_over(g, occ_of), 0) << " | " << cell(g, stat_over(g, cov_of), 1) << " | "
-       << safety_text(g) << " |\n";
+       << " | " << floors_text(g) << " | " << end_text(g) << " | "
+       << cell(g, stat_over(g, time_of), 0) << " | " << cell(g, stat_over(g, dist_of), 0) << " | "
+       << cell(g, stat_over(g, trav_of), 0) << " | " << cell(g, stat_over(g, occ_of), 0) << " | "
+       << cell(g, stat_over(g, cov_of), 1) << " | " << safety_text(g) << " |\n";
   }
   for (const auto& g : groups) {
     const auto ms = finished_metrics(g);
@@ -265,7 +288,8 @@ std::string results_markdown(const ResultsInput& in) {
   }
   md << "\nSucc.: every floor explored in the seed (paper: \"explores all floors\"); Yes / No / "
         "seeds that did. Floors: the floors explored (1 = lowest), the most common set over the "
-        "seeds.";
+        "seeds. End: how the finished seeds ended (done: exploration complete; limit: --time-limit "
+        "reached, the time column is then the limit).";
   if (!truth_notes.empty()) {
     md << " Ground truth:";
     for (size_t i = 0; i < truth_notes.size(); ++i) md << (i ? ";" : "") << " " << truth_notes[i];

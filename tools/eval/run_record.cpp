@@ -1,5 +1,6 @@
 #include "tools/eval/run_record.hpp"
 
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 
@@ -104,6 +105,21 @@ std::string last_line(const std::string& path) {
     if (!line.empty()) last = line;
   }
   return last;
+}
+
+double last_simulated_time(const std::string& path) {
+  std::ifstream f(path, std::ios::binary | std::ios::ate);
+  if (!f) return -1.0;
+  const std::streamoff size = f.tellg();
+  const std::streamoff from = size > 4096 ? size - 4096 : 0;
+  f.seekg(from);
+  std::string tail(size_t(size - from), '\0');
+  f.read(tail.data(), std::streamsize(tail.size()));
+  const size_t at = tail.rfind("[sim ");
+  if (at == std::string::npos) return -1.0;
+  char* end = nullptr;
+  const double t = std::strtod(tail.c_str() + at + 5, &end);
+  return end && end != tail.c_str() + at + 5 && t >= 0 ? t : -1.0;
 }
 
 const char* to_string(RunStatus s) {

@@ -38,6 +38,9 @@ std::optional<MetricsRecord> read_metrics_json(const std::string& path, std::str
 std::string read_report_outcome(const std::string& report_md_path);
 // The last non-empty line of a text file (a failed child's reason); "" when none.
 std::string last_line(const std::string& path);
+// The simulated time of the last `storey sim` progress line ("[sim   12.5 s] ...") in the last
+// 4 KiB of a log; -1 when there is none.
+double last_simulated_time(const std::string& log_path);
 
 enum class RunStatus {
   finished,  // complete metrics.json (success or not: a baseline that stays on one floor finishes)

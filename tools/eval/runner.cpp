@@ -35,13 +35,20 @@ struct Running {
   pid_t pid;
   Clock::time_point start;
   std::string staging, final_dir;
+  double sim_t = -1.0;  // simulated seconds reached, from the child's progress lines
+  Clock::time_point polled{};
+};
+
+struct RunningInfo {
+  double elapsed_s, sim_t;
 };
 
 // The progress bar: one line on a terminal (rewritten with '\r'), otherwise one line per run.
 class Progress {
  public:
-  Progress(FILE* out, size_t total, size_t resumed, int jobs)
-      : out_(out),
+  Progress(FILE* out, size_t total, size_t resumed, int jobs, double time_limit_s)
+      : limit_(time_limit_s),
+        out_(out),
         tty_(out && isatty(fileno(out))),
         total_(total),
         resumed_(resumed),
@@ -65,8 +72,8 @@ class Progress {
     }
     draw(true);
   }
-  // Running children's elapsed seconds, for the ETA.
-  void set_running(std::vector<double> elapsed) { running_ = std::move(elapsed); }
+  // Running children's elapsed wall and simulated seconds, for the ETA.
+  void set_running(std::vector<RunningInfo> r) { running_ = std::move(r); }
   void draw(bool force = false) {
     if (!out_ || !tty_) return;
     if (!force && seconds_since(last_draw_) < 0.5) return;
@@ -98,24 +105,41 @@ class Progress {
     return s;
   }
   // Mean wall time of the runs finished so far (instant failures excluded), spread over the
-  // job slots: what is left of the running ones plus the ones not started.
+  // job slots: what is left of the running ones plus the ones not started. Before any run has
+  // finished: each running child's pace (simulated / wall seconds) extrapolated to the time
+  // limit, an upper bound since explorations usually complete earlier ("<= ").
   std::string eta() const {
-    if (timed_ == 0) return "--";
-    const double mean = wall_sum_ / double(timed_);
     const size_t started = done_ + running_.size();
     const size_t to_run = total_ - resumed_;
-    double work = double(to_run > started ? to_run - started : 0) * mean;
-    for (const double e : running_) work += std::max(0.0, mean - e);
-    return format_duration(work / double(jobs_));
+    const double not_started = double(to_run > started ? to_run - started : 0);
+    if (timed_ > 0) {
+      const double mean = wall_sum_ / double(timed_);
+      double work = not_started * mean;
+      for (const auto& r : running_) work += std::max(0.0, mean - r.elapsed_s);
+      return format_duration(work / double(jobs_));
+    }
+    double work = 0, total_sum = 0;
+    size_t paced = 0;
+    for (const auto& r : running_) {
+      if (r.sim_t < 1.0) continue;
+      const double total = r.elapsed_s * limit_ / r.sim_t;
+      work += std::max(0.0, total - r.elapsed_s);
+      total_sum += total;
+      ++paced;
+    }
+    if (paced == 0) return "--";
+    work += not_started * total_sum / double(paced);
+    return "<= " + format_duration(work / double(jobs_));
   }
 
+  double limit_;
   FILE* out_;
   bool tty_;
   size_t total_, resumed_;
   int jobs_;
   size_t done_ = 0, failed_ = 0, timed_ = 0;
   double wall_sum_ = 0.0;
-  std::vector<double> running_;
+  std::vector<RunningInfo> running_;
   Clock::time_point start_ = Clock::now(), last_draw_{};
 };
 
@@ -162,14 +186,32 @@ std::vector<RunOutcome> Runner::run(const std::vector<RunSpec>& specs) {
     std::fprintf(o_.progress,
                  "storey-eval: %zu of %zu runs already finished (resumed), %zu to run\n",
                  specs.size() - pending.size(), specs.size(), pending.size());
-  Progress progress(o_.progress, specs.size(), specs.size() - pending.size(), o_.jobs);
+  Progress progress(o_.progress, specs.size(), specs.size() - pending.size(), o_.jobs,
+                    o_.time_limit_s);
+  // Reads the children's progress lines every 2 s (only for the ETA).
+  auto running_info = [&](std::vector<Running>& rs) {
+    std::vector<RunningInfo> v;
+    for (auto& r : rs) {
+      if (seconds_since(r.polled) > 2.0) {
+        r.polled = Clock::now();
+        r.sim_t = last_simulated_time(r.staging + "/log.txt");
+      }
+      v.push_back({seconds_since(r.start), r.sim_t});
+    }
+    return v;
+  };
   std::vector<Running> running;
   size_t next = 0;
 
   auto start_one = [&](size_t i) {
     const RunSpec& spec = specs[i];
-    Running r{i, -1, Clock::now(), o_.out_dir + "/" + spec.rel_dir() + ".partial",
-              o_.out_dir + "/" + spec.rel_dir()};
+    Running r{i,
+              -1,
+              Clock::now(),
+              o_.out_dir + "/" + spec.rel_dir() + ".partial",
+              o_.out_dir + "/" + spec.rel_dir(),
+              -1.0,
+              Clock::now()};
     std::error_code ec;
     fs::remove_all(r.staging, ec);
     fs::create_directories(r.staging, ec);
@@ -248,9 +290,7 @@ std::vector<RunOutcome> Runner::run(const std::vector<RunSpec>& specs) {
     loaded.exit_code = o.exit_code;
     loaded.wall_s = wall;
     out[r.index] = loaded;
-    std::vector<double> elapsed;
-    for (const auto& x : running) elapsed.push_back(seconds_since(x.start));
-    progress.set_running(std::move(elapsed));
+    progress.set_running(running_info(running));
     progress.finished(loaded, wall);
   };
 
@@ -272,9 +312,7 @@ std::vector<RunOutcome> Runner::run(const std::vector<RunSpec>& specs) {
         ++k;
       }
     }
-    std::vector<double> elapsed;
-    for (const auto& r : running) elapsed.push_back(seconds_since(r.start));
-    progress.set_running(std::move(elapsed));
+    progress.set_running(running_info(running));
     progress.draw();
     if (!reaped && !running.empty()) std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
