@@ -160,6 +160,7 @@ ExplorationResult ExplorationPlanner::plan_cycle(const ExplorationInput& in) {
   if (!in.view || !in.graph || !in.clusters || !in.viewpoints || !in.robot_foot_m.allFinite() ||
       !std::isfinite(in.t_s)) {
     r.reason = "bad input (null pointer or non-finite pose/time)";
+    hybrid_updated_last_ = false;  // its changed regions are not seen by the maintenance
     return r;
   }
   const graph::ReachableGraph& g = *in.graph;
@@ -187,8 +188,13 @@ ExplorationResult ExplorationPlanner::plan_cycle(const ExplorationInput& in) {
   li.t_s = in.t_s;
   bool zones_left = false;
   const bool on_target = hybrid_.has_prior() && hybrid_.target_floor() == r.floor;
+  if (!on_target) hybrid_updated_last_ = false;
   if (on_target) {
-    r.maintenance = hybrid_.update(*in.view, in.map_version, g, floors_, in.robot_foot_m, opt_);
+    // Changed regions only count if the previous cycle's maintenance saw the ones before.
+    const std::vector<graph::Aabb>* changed = hybrid_updated_last_ ? in.changed_regions : nullptr;
+    r.maintenance =
+        hybrid_.update(*in.view, in.map_version, g, floors_, in.robot_foot_m, opt_, changed);
+    hybrid_updated_last_ = true;
     for (const HybridZone& z : hybrid_.zones())
       r.zones.push_back({z.id, z.state, hybrid_.nodes()[z.centre].p_m, int(z.nodes.size()),
                          z.real_nodes, z.hyp_nodes, z.frontier_nodes});

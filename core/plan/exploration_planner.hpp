@@ -44,6 +44,10 @@ struct ExplorationInput {
   Eigen::Vector3d robot_foot_m = Eigen::Vector3d::Zero();  // ground point under the robot [m]
   double robot_yaw_rad = 0;
   double t_s = 0;  // now, on the trajectory's time base [s]
+  // Map regions changed since the previous plan() call (e.g. the map task's MapChangeDetector
+  // boxes, merged over the versions in between). nullptr: unknown; then every hypothesis within
+  // hyp_check_radius_m is re-checked on each new map version (correct, slower).
+  const std::vector<graph::Aabb>* changed_regions = nullptr;
 };
 
 enum class ExplorationStatus : uint8_t {
@@ -114,6 +118,7 @@ class ExplorationPlanner {
   TrajectoryBuilder builder_;
   CollisionChecker checker_;
   StageProbe* probe_ = nullptr;
+  bool hybrid_updated_last_ = false;  // the previous cycle ran the hybrid-graph maintenance
   std::vector<int32_t> set_aside_zones_;
   // Scratch.
   std::vector<graph::FrontierCluster> sel_clusters_;

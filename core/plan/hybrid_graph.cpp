@@ -108,6 +108,8 @@ void HybridGraph::bind_real_nodes(const graph::ReachableGraph& g, const FloorTra
         (g.node(h.bound).p_m - h.bound_p).norm() > kRecycleTolM) {
       h.bound = kNoId;
       h.state = ElementState::kHypothetical;
+      h.in_range = 0;  // standing alone again: checked on the next version wherever it is
+      h.touched = check_cycle_ + 1;
     }
   }
   const double r2 = opt.hyp_promote_radius_m * opt.hyp_promote_radius_m;
@@ -134,6 +136,7 @@ void HybridGraph::bind_real_nodes(const graph::ReachableGraph& g, const FloorTra
           h.bound = id;
           h.bound_p = gn.p_m;
           h.state = gn.state;
+          h.touched = check_cycle_ + 1;  // its edges are re-checked on the next version
           ++st.bound;
           // The merged node keeps the hypothesis' zone unless it already has a label.
           if (real_zone_[id] < 0 || (real_zone_p_[id] - gn.p_m).norm() > kRecycleTolM) {
@@ -147,7 +150,21 @@ void HybridGraph::bind_real_nodes(const graph::ReachableGraph& g, const FloorTra
 
 void HybridGraph::check_hypotheses(const map::MapView& view, const graph::ReachableGraph& g,
                                    const Eigen::Vector3d& robot, const PlanOptions& opt,
-                                   MaintenanceStats& st) {
+                                   const std::vector<graph::Aabb>* changed, MaintenanceStats& st) {
+  // What a verdict reads: the column within the height window and the body's footprint around
+  // it (SupportQuery's node test), or the voxels along an edge.
+  constexpr float kReadMarginM = 1.0f;
+  const uint32_t cycle = ++check_cycle_;
+  auto changed_near = [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+    if (!changed) return true;
+    const Eigen::Vector3f lo = a.cwiseMin(b).cast<float>().array() - kReadMarginM;
+    const Eigen::Vector3f hi = a.cwiseMax(b).cast<float>().array() + kReadMarginM;
+    for (const graph::Aabb& box : *changed)
+      if (!box.empty() && (box.lo.array() <= hi.array()).all() &&
+          (lo.array() <= box.hi.array()).all())
+        return true;
+    return false;
+  };
   graph::SupportQuery q(view, g.options());
   const double r2 = opt.hyp_check_radius_m * opt.hyp_check_radius_m;
   auto near_robot = [&](const Eigen::Vector3d& p) {
@@ -164,6 +181,10 @@ void HybridGraph::check_hypotheses(const map::MapView& view, const graph::Reacha
     if (!h.alive || h.bound != kNoId || h.state != ElementState::kHypothetical ||
         !near_robot(h.p_m))
       continue;
+    const bool fresh = h.in_range + 1 != cycle;  // not in range on the previous check
+    h.in_range = cycle;
+    if (!fresh && !changed_near(h.p_m, h.p_m)) continue;
+    h.touched = cycle;
     const Eigen::Vector3f p = h.p_m.cast<float>();
     bool negative = false;
     const auto s = q.surface_near(p.x(), p.y(), p.z(), opt.hyp_height_window_m);
@@ -202,6 +223,9 @@ void HybridGraph::check_hypotheses(const map::MapView& view, const graph::Reacha
     }
     const Eigen::Vector3d pa = pos(a), pb = pos(b);
     if (!near_robot(0.5 * (pa + pb))) continue;
+    const bool fresh = e.in_range + 1 != cycle;
+    e.in_range = cycle;
+    if (!fresh && a.touched != cycle && b.touched != cycle && !changed_near(pa, pb)) continue;
     if (a.bound != kNoId && a.bound == b.bound) continue;  // both merged into one node
     if (segment_blocked(view, pa, pb)) {
       e.alive = false;
@@ -515,7 +539,8 @@ void HybridGraph::collect_zones(const Eigen::Vector3d& robot, const PlanOptions&
 
 MaintenanceStats HybridGraph::update(const map::MapView& view, uint64_t map_version,
                                      const graph::ReachableGraph& g, const FloorTracker& floors,
-                                     const Eigen::Vector3d& robot, const PlanOptions& opt) {
+                                     const Eigen::Vector3d& robot, const PlanOptions& opt,
+                                     const std::vector<graph::Aabb>* changed) {
   MaintenanceStats st;
   if (!has_prior()) {
     nodes_.clear();
@@ -530,7 +555,7 @@ MaintenanceStats HybridGraph::update(const map::MapView& view, uint64_t map_vers
   if (map_version != last_version_) {
     last_version_ = map_version;
     probe_mark(probe_, PlanStage::kHybridCheck);
-    check_hypotheses(view, g, robot, opt, st);
+    check_hypotheses(view, g, robot, opt, changed, st);
   }
   probe_mark(probe_, PlanStage::kHybridCompile);
   compile(view, g, floors, opt);

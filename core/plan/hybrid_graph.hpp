@@ -22,7 +22,10 @@
 //   window while the voxels at the projected height and 0.3 m above are known) counts one
 //   negative observation; hyp_discard_observations of them discard the hypothesis for good.
 //  Hypotheses are only re-checked within hyp_check_radius_m of the robot (the map changes
-//   where the robot scans), at most once per map version.
+//   where the robot scans), at most once per map version; when the caller passes the map's
+//   changed regions, only those near a change (or that just came within the radius, or whose
+//   binding changed) are re-checked: negative evidence then counts once per change near the
+//   column instead of once per version (repeated observations, not repeated versions).
 //  Zones (IV-B 2, only with incremental_maintenance): 1) connectivity split: per zone, the
 //   component of c_k along valid edges inside the zone (the largest one if c_k is isolated or
 //   gone) keeps the label, the rest is unassigned; 2) unassigned target-floor nodes (detached
@@ -106,9 +109,12 @@ class HybridGraph {
 
   // One planning cycle: compile G_real (from `g`, floors labelled by `floors`) with the
   // hypotheses, maintain them (promotion, validation, discard, zones) and classify the zones.
+  // `changed`: map regions changed since the previous update (nullptr: unknown, re-check every
+  // hypothesis within hyp_check_radius_m on a new version).
   MaintenanceStats update(const map::MapView& view, uint64_t map_version,
                           const graph::ReachableGraph& g, const FloorTracker& floors,
-                          const Eigen::Vector3d& robot_foot_m, const PlanOptions& opt);
+                          const Eigen::Vector3d& robot_foot_m, const PlanOptions& opt,
+                          const std::vector<graph::Aabb>* changed = nullptr);
 
   // Compiled hybrid graph of the last update.
   const SearchGraph& search_graph() const { return csr_; }
@@ -133,11 +139,14 @@ class HybridGraph {
     Eigen::Vector3f bound_p;                           // its position then (id recycling)
     uint8_t negative = 0;
     bool alive = true;
+    uint32_t in_range = 0;  // last check cycle it was within hyp_check_radius_m
+    uint32_t touched = 0;   // check cycle in which it was re-checked or (un)bound
   };
   struct HypEdge {
     uint32_t a, b;  // hyp indices
     ElementState state = ElementState::kHypothetical;
     bool alive = true;
+    uint32_t in_range = 0;
   };
   struct ZoneRec {
     bool alive = true;
@@ -148,7 +157,8 @@ class HybridGraph {
   };
 
   void check_hypotheses(const map::MapView& view, const graph::ReachableGraph& g,
-                        const Eigen::Vector3d& robot, const PlanOptions& opt, MaintenanceStats& st);
+                        const Eigen::Vector3d& robot, const PlanOptions& opt,
+                        const std::vector<graph::Aabb>* changed, MaintenanceStats& st);
   void bind_real_nodes(const graph::ReachableGraph& g, const FloorTracker& floors,
                        const PlanOptions& opt, MaintenanceStats& st);
   void compile(const map::MapView& view, const graph::ReachableGraph& g, const FloorTracker& floors,
@@ -170,6 +180,7 @@ class HybridGraph {
   double grid_m_ = 1.0;
   std::vector<ZoneRec> zone_recs_;
   uint64_t last_version_ = ~uint64_t(0);
+  uint32_t check_cycle_ = 1;  // check_hypotheses calls + 1 (0 = "never" in HypNode::in_range)
   // Zone labels of real nodes by id, with the position they had when labelled (ids recycle).
   std::vector<int32_t> real_zone_;
   std::vector<Eigen::Vector3f> real_zone_p_;

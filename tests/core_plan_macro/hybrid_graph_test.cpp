@@ -153,3 +153,88 @@ TEST(HybridGraph, HypothesisConfirmedWhenObservedAndDiscardedAfterRepeatedEmptyO
       hg.update(h.map.view(), h.map.version(), h.graph, ft, foot.cast<double>(), opt);
   EXPECT_EQ(again.negative, 0u);
 }
+
+TEST(HybridGraph, ChangedRegionsLimitReChecksToWhereTheMapChanged) {
+  // The pit world of the previous test, both graphs fed the same scans.
+  World w;
+  w.add({-1, -1, -0.2f}, {4, 5, 0});
+  w.add({-1, -1, -1.0f}, {10, 5, -0.8f});
+  w.add({10, -1, -1.0f}, {10.2f, 5, 2.5f});
+  ToyGraph t;
+  t.add_room({0, 0, 6.4, 4}, 0.8, 0);
+  const SearchGraph g = t.csr();
+  TaskZonePartitioner part;
+  const ZonePartition zones = part.partition(g, t.clearance, {6.0, 4});
+  Harness h;
+  FloorTracker ft;
+  ft.update(0.0, 0.0);
+  HybridGraph full, regions;
+  full.init_prior(g, zones, 0.0, 0);
+  regions.init_prior(g, zones, 0.0, 0);
+  PlanOptions opt;
+  opt.hyp_discard_observations = 10;  // none discarded: evidence keeps counting
+  const Eigen::Vector3f foot(3, 2, 0);
+  // Each scan changes the whole room: a region covering it re-checks what the full check does.
+  std::vector<storey::core::graph::Aabb> room(1);
+  room[0].extend({-1, -1, -1.5f});
+  room[0].extend({11, 6, 3});
+  for (uint32_t i = 0; i < 4; ++i) {
+    h.observe(w, foot, 30000, 10 + i);
+    const auto view = h.map.view();
+    const MaintenanceStats a =
+        full.update(view, h.map.version(), h.graph, ft, foot.cast<double>(), opt);
+    const MaintenanceStats b =
+        regions.update(view, h.map.version(), h.graph, ft, foot.cast<double>(), opt, &room);
+    EXPECT_EQ(a.promoted, b.promoted) << i;
+    EXPECT_EQ(a.negative, b.negative) << i;
+    EXPECT_EQ(a.discarded, b.discarded) << i;
+    EXPECT_EQ(a.edges_confirmed, b.edges_confirmed) << i;
+    EXPECT_EQ(a.edges_pruned, b.edges_pruned) << i;
+  }
+  EXPECT_EQ(full.hypotheses_alive(), regions.hypotheses_alive());
+  // A new version that changed nothing near the hypotheses: the full check counts negative
+  // evidence again, the region-aware one re-checks nothing (no new observation of a column).
+  const std::vector<storey::core::graph::Aabb> elsewhere = {
+      storey::core::graph::Aabb{{50, 50, 0}, {52, 52, 1}}};
+  const auto view = h.map.view();
+  const uint64_t v = h.map.version() + 1;
+  EXPECT_GT(full.update(view, v, h.graph, ft, foot.cast<double>(), opt).negative, 0u);
+  const MaintenanceStats none =
+      regions.update(view, v, h.graph, ft, foot.cast<double>(), opt, &elsewhere);
+  EXPECT_EQ(none.negative + none.promoted + none.edges_pruned + none.edges_confirmed, 0u);
+}
+
+TEST(HybridGraph, HypothesesComingIntoRangeAreCheckedWithoutAChangeNearThem) {
+  World w;
+  w.add({-1, -1, -0.2f}, {4, 5, 0});
+  w.add({-1, -1, -1.0f}, {10, 5, -0.8f});
+  w.add({10, -1, -1.0f}, {10.2f, 5, 2.5f});
+  ToyGraph t;
+  t.add_room({0, 0, 6.4, 4}, 0.8, 0);
+  const SearchGraph g = t.csr();
+  TaskZonePartitioner part;
+  const ZonePartition zones = part.partition(g, t.clearance, {6.0, 4});
+  Harness h;
+  FloorTracker ft;
+  ft.update(0.0, 0.0);
+  HybridGraph hg;
+  hg.init_prior(g, zones, 0.0, 0);
+  PlanOptions opt;
+  opt.hyp_check_radius_m = 2.0;
+  const Eigen::Vector3f foot(3, 2, 0);
+  h.observe(w, foot, 30000, 10);
+  const auto view = h.map.view();
+  // The robot (as far as the check radius goes) is away from the pit: nothing over it checked.
+  const Eigen::Vector3d away(-10, 2, 0);
+  hg.update(view, h.map.version(), h.graph, ft, away, opt);
+  const std::vector<storey::core::graph::Aabb> none;
+  // It comes near the pit on a version that changed nothing: the columns now in range are
+  // checked once (negative evidence over the pit), then not again until the map changes.
+  const Eigen::Vector3d near_pit(5.5, 2, 0);
+  const MaintenanceStats a =
+      hg.update(view, h.map.version() + 1, h.graph, ft, near_pit, opt, &none);
+  EXPECT_GT(a.negative, 0u);
+  const MaintenanceStats b =
+      hg.update(view, h.map.version() + 2, h.graph, ft, near_pit, opt, &none);
+  EXPECT_EQ(b.negative, 0u);
+}
