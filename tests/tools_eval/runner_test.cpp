@@ -150,6 +150,22 @@ TEST(Runner, ASignalledOrMissingChildIsAFailedRunNotAnAbort) {
   EXPECT_NE(missing[0].reason.find("no-such-storey"), std::string::npos) << missing[0].reason;
 }
 
+TEST(Runner, AfterAStopRequestNothingNewStartsAndFinishedRunsStillCount) {
+  FakeStorey fake;
+  const std::string out = fake.dir + "/eval";
+  fake.runner(out).run(expand_matrix({{{"box"}, {"storey"}, {"full"}}}, {1}));
+  ASSERT_EQ(fake.call_lines().size(), 1u);
+  Runner::request_stop();
+  const auto res = fake.runner(out).run(expand_matrix({{{"box"}, {"storey"}, {"full"}}}, {1, 2}));
+  Runner::clear_stop();
+  EXPECT_EQ(fake.call_lines().size(), 1u);
+  ASSERT_EQ(res.size(), 2u);
+  EXPECT_EQ(res[0].status, RunStatus::finished);
+  EXPECT_TRUE(res[0].resumed);
+  EXPECT_EQ(res[1].status, RunStatus::not_run);
+  EXPECT_FALSE(fs::exists(out + "/runs/box/storey/seed2"));
+}
+
 TEST(Runner, FormatDuration) {
   EXPECT_EQ(format_duration(12.2), "12s");
   EXPECT_EQ(format_duration(245), "4m05s");

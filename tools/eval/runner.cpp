@@ -168,6 +168,9 @@ void Runner::request_stop() {
 bool Runner::stop_requested() {
   return g_stop != 0;
 }
+void Runner::clear_stop() {
+  g_stop = 0;
+}
 
 std::vector<RunOutcome> Runner::run(const std::vector<RunSpec>& specs) {
   std::vector<RunOutcome> out(specs.size());
@@ -295,10 +298,17 @@ std::vector<RunOutcome> Runner::run(const std::vector<RunSpec>& specs) {
   };
 
   const int jobs = std::max(1, o_.jobs);
+  bool forwarded = false;
   while (next < pending.size() || !running.empty()) {
     while (!g_stop && next < pending.size() && int(running.size()) < jobs)
       start_one(pending[next++]);
-    if (g_stop) next = pending.size();  // the rest stay not_run
+    if (g_stop && !forwarded) {
+      // A signal sent to storey-eval alone (kill, systemd) reaches the children here; Ctrl-C
+      // reached them already (same process group) and this second one is harmless.
+      next = pending.size();  // the rest stay not_run
+      for (const auto& r : running) kill(r.pid, SIGTERM);
+      forwarded = true;
+    }
     bool reaped = false;
     for (size_t k = 0; k < running.size();) {
       int status = 0;

@@ -30,10 +30,11 @@ class Runner {
   // a failed run (recorded as failed with its reason); throws std::runtime_error when out_dir
   // cannot be written.
   std::vector<RunOutcome> run(const std::vector<RunSpec>& specs);
-  // Async-signal-safe: no new child is started; running ones are waited for (a Ctrl-C reaches
-  // them too), their folders left as .partial and the specs reported not_run.
+  // Async-signal-safe: no new child is started; running ones get SIGTERM and are waited for,
+  // their .partial folders removed and their specs reported not_run.
   static void request_stop();
   static bool stop_requested();
+  static void clear_stop();  // before reusing runners after a stop (tests)
 
  private:
   RunnerOptions o_;
