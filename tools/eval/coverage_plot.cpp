@@ -125,7 +125,15 @@ void write_coverage_plot(const std::string& path, const std::string& title,
   // Colour-blind-friendly palette (Okabe-Ito), then greys.
   static const Rgb palette[] = {{0, 114, 178}, {213, 94, 0},   {0, 158, 115}, {204, 121, 167},
                                 {230, 159, 0}, {86, 180, 233}, {0, 0, 0},     {120, 120, 120}};
-  const int W = 960, H = 540, left = 70, right = 250, top = 44, bottom = 60;
+  // The legend sets the width: the plot area stays 640 px, the longest label fits beside it.
+  auto legend_label = [](const CoverageCurve& c) {
+    return c.label + " (" + std::to_string(c.runs) + ")";
+  };
+  int legend_w = 0;
+  for (const auto& c : curves) legend_w = std::max(legend_w, text_width(legend_label(c), 2));
+  const int left = 70, top = 44, bottom = 60, right = std::max(250, 60 + legend_w);
+  const int W = left + 640 + right;
+  const int H = std::max(540, top + bottom + 16 + 24 * int(curves.size()));
   const int px0 = left, px1 = W - right, py0 = top, py1 = H - bottom;
   Image img(W, H);
   const Rgb ink{30, 30, 30}, grid{225, 225, 225};
@@ -170,8 +178,7 @@ void write_coverage_plot(const std::string& path, const std::string& title,
     }
     const int ly = py0 + 8 + int(i) * 24;
     fill_rect(img, px1 + 16, ly + 2, px1 + 36, ly + 10, col);
-    const std::string l = c.label + " (" + std::to_string(c.runs) + ")";
-    draw_text(img, px1 + 44, ly, l, ink, 2);
+    draw_text(img, px1 + 44, ly, legend_label(c), ink, 2);
   }
   img.save_png(path);
 }

@@ -348,15 +348,15 @@ std::string results_markdown(const ResultsInput& in) {
         targets.emplace_back(g.scene, g.method);
     for (const auto& [scene, method] : targets) {
       md << "## " << t.title << " (" << scene << ", " << method << ")\n\n"
-         << "| Configuration | Runs | Exp. time (s) | Traj. dist. (m) | Occ. vol. (m³) | "
+         << "| Configuration | Runs | End | Exp. time (s) | Traj. dist. (m) | Occ. vol. (m³) | "
          << t.floor_name << "-floor time (s) | " << t.floor_name << "-floor cov. (%) |\n"
-         << "|---|---|---|---|---|---|---|\n";
+         << "|---|---|---|---|---|---|---|---|\n";
       for (const auto& name : *t.members) {
         const std::string ab = name == "full" ? "" : name;
         for (const auto& g : groups) {
           if (g.scene != scene || g.method != method || g.ablation != ab) continue;
           const size_t f = t.floor;
-          md << "| " << ablation_label(ab) << " | " << runs_text(g) << " | "
+          md << "| " << ablation_label(ab) << " | " << runs_text(g) << " | " << end_text(g) << " | "
              << cell(g, stat_over(g, time_of), 0) << " | " << cell(g, stat_over(g, dist_of), 0)
              << " | " << cell(g, stat_over(g, occ_of), 0) << " | "
              << cell(g,
