@@ -208,6 +208,76 @@ bool SupportQuery::probe_open(const Eigen::Vector3f& from, const Eigen::Vector3f
   return !hit && unknown_run >= need_unknown;
 }
 
+bool SupportQuery::probe_open_climbing(const Eigen::Vector3f& foot, const Eigen::Vector2f& dir,
+                                       float length_m, float height_m, float min_free_m,
+                                       float min_unknown_m) {
+  constexpr int kMaxClimbs = 24;
+  // Horizontal probe: |dx| + |dy| voxels per metre (6-connected walk).
+  const float per_m = (std::abs(dir.x()) + std::abs(dir.y())) * inv_vs_;
+  const int need_free = int(std::ceil(min_free_m * per_m));
+  const int need_unknown = std::max(1, int(std::ceil(min_unknown_m * per_m)));
+  const float max_rise = 2.0f * step_;
+  float s0 = 0, s_climb = 0, zc = foot.z();
+  int free_total = 0, unknown_run = 0;
+  for (int climb = 0; climb <= kMaxClimbs && s0 < length_m; ++climb) {
+    const Eigen::Vector3f from(foot.x() + dir.x() * s0, foot.y() + dir.y() * s0, zc + height_m);
+    const Eigen::Vector3f to(foot.x() + dir.x() * length_m, foot.y() + dir.y() * length_m,
+                             zc + height_m);
+    const VoxelKey start{int32_t(std::floor(from.x() * inv_vs_)),
+                         int32_t(std::floor(from.y() * inv_vs_)), zkey(from.z())};
+    VoxelKey hit{};
+    bool occupied_hit = false, closed = false;
+    auto visit = [&](const VoxelKey& k) {
+      if (k == start) return true;
+      switch (occupancy(k)) {
+        case Occupancy::kOccupied:
+          occupied_hit = true;
+          hit = k;
+          return false;
+        case Occupancy::kFree:
+          ++free_total;
+          unknown_run = 0;
+          return true;
+        case Occupancy::kUnknown:
+          if (free_total < need_free) {
+            closed = true;
+            return false;
+          }
+          ++unknown_run;
+          return true;
+      }
+      return false;
+    };
+    map::walk_ray(from.x() * inv_vs_, from.y() * inv_vs_, from.z() * inv_vs_, to.x() * inv_vs_,
+                  to.y() * inv_vs_, to.z() * inv_vs_, visit);
+    if (closed) return false;
+    if (!occupied_hit) return unknown_run >= need_unknown;
+    const float hx = (float(hit.x) + 0.5f) * vs_, hy = (float(hit.y) + 0.5f) * vs_;
+    const float s_hit = (Eigen::Vector2f(hx, hy) - foot.head<2>()).dot(dir);
+    const std::optional<Support> top = surface_near(hx, hy, zc + 0.5f * max_rise, 0.5f * max_rise);
+    const float rise = top ? top->p_m.z() - zc : 0.0f;
+    if (top && rise > 0.5f * vs_ && rise <= max_rise &&
+        rise <= step_ + tan_slope_ * std::max(0.0f, s_hit - s_climb)) {
+      // A step up onto support the LiDAR saw only edge-on (a tread seen from below: its
+      // riser's top, N(v) < N_min): terrain not yet observed, what the probe looks for.
+      if (top->state == TravState::kUnobserved) return free_total >= need_free;
+      zc = top->p_m.z();
+      s_climb = s_hit;
+      s0 = std::max(s_hit, s0 + 0.5f * vs_);
+      unknown_run = 0;
+      continue;
+    }
+    // Unknown right above the obstacle (within two voxels): terrain beyond a step not yet seen.
+    for (int32_t dz = 1; dz <= 2; ++dz) {
+      const Occupancy o = occupancy({hit.x, hit.y, hit.z + dz});
+      if (o == Occupancy::kUnknown) return free_total >= need_free;
+      if (o == Occupancy::kFree) break;
+    }
+    return false;
+  }
+  return false;
+}
+
 Reject SupportQuery::classify_node(const Support& s, bool* confirmed) {
   *confirmed = false;
   if (s.state == TravState::kUntraversable || s.state == TravState::kNone)

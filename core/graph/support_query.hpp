@@ -91,6 +91,17 @@ class SupportQuery {
   bool probe_open(const Eigen::Vector3f& from, const Eigen::Vector3f& to, float min_free_m,
                   float min_unknown_m);
 
+  // C_exp probe over rising terrain (stairs, ramps): walks from `foot` along the horizontal unit
+  // `dir` at `height_m` above the current support. An obstacle whose top is a support within
+  // two steps above the current one (and within the edge slope) is climbed: the probe continues
+  // at height_m above it. Climbing onto under-observed support (S_unobs: a tread seen only
+  // edge-on from below) or meeting an obstacle with unknown space right above it counts as
+  // reaching unobserved terrain (open). Otherwise as probe_open. Without this, a stair's risers
+  // close every probe at body height up the flight and the stairs never become a frontier (paper
+  // III-C: stairs are the way to the next floor).
+  bool probe_open_climbing(const Eigen::Vector3f& foot, const Eigen::Vector2f& dir, float length_m,
+                           float height_m, float min_free_m, float min_unknown_m);
+
   const map::MapView& view() const { return view_; }
   float voxel_size() const { return vs_; }
   float step() const { return step_; }

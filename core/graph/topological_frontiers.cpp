@@ -52,7 +52,6 @@ int TopologicalFrontiers::open_directions(SupportQuery& q, const ReachableGraph&
   const GraphNode& n = g.node(i);
   const int probes = std::max(1, opt_.probes);
   const float half = float(opt_.alpha_min_rad) * 0.5f;
-  const Eigen::Vector3f from = n.p_m + Eigen::Vector3f(0, 0, float(opt_.probe_height_m));
   const float min_free = 2.0f * q.voxel_size();
   int open = 0;
   for (int k = 0; k < probes; ++k) {
@@ -65,9 +64,9 @@ int TopologicalFrontiers::open_directions(SupportQuery& q, const ReachableGraph&
       covered = std::abs(diff) < half;
     }
     if (covered) continue;
-    const Eigen::Vector3f to =
-        from + float(opt_.probe_length_m) * Eigen::Vector3f(std::cos(th), std::sin(th), 0);
-    open += q.probe_open(from, to, min_free, float(opt_.probe_unknown_m));
+    open += q.probe_open_climbing(n.p_m, Eigen::Vector2f(std::cos(th), std::sin(th)),
+                                  float(opt_.probe_length_m), float(opt_.probe_height_m), min_free,
+                                  float(opt_.probe_unknown_m));
   }
   return open;
 }

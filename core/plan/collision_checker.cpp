@@ -152,8 +152,32 @@ CollisionHit CollisionChecker::check_poses(std::span<const BodyPose> poses,
   return h;
 }
 
+namespace {
+// Below this the floor's surface noise (a few cm over the body length) would tilt the box on
+// flat ground; stairs (~30 deg) and ramps are well above it.
+constexpr double kMinTerrainPitchRad = 0.1;
+}  // namespace
+
+std::optional<double> CollisionChecker::terrain_pitch(const map::MapView& view,
+                                                      const BodyPose& p) const {
+  const double half = 0.5 * robot_.body_length_m;
+  const Eigen::Vector3d fwd(std::cos(p.yaw_rad), std::sin(p.yaw_rad), 0);
+  // Slope window: the body's half length at 40 deg plus a step.
+  const double window = half * 0.84 + robot_.step_height_m;
+  const auto front = view.support_surface_near((p.foot_m + half * fwd).cast<float>(), window);
+  const auto back = view.support_surface_near((p.foot_m - half * fwd).cast<float>(), window);
+  if (!front || !back) return std::nullopt;
+  return std::atan2(double(front->height_m) - double(back->height_m), 2.0 * half);
+}
+
 CollisionHit CollisionChecker::check_poses(const map::MapView& view,
-                                           std::span<const BodyPose> poses) {
+                                           std::span<const BodyPose> in_poses) {
+  adjusted_.assign(in_poses.begin(), in_poses.end());
+  for (BodyPose& p : adjusted_)
+    if (finite(p))
+      if (const auto tp = terrain_pitch(view, p); tp && std::abs(*tp) >= kMinTerrainPitchRad)
+        p.pitch_rad = *tp;
+  const std::span<const BodyPose> poses(adjusted_);
   CollisionHit h;
   const double half_diag = 0.5 * std::hypot(box_m_.x(), box_m_.y());
   const double pad = half_diag + voxel_m_;

@@ -19,6 +19,7 @@
 #include <cmath>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -64,7 +65,13 @@ class CollisionChecker {
   CollisionHit check_poses(std::span<const BodyPose> poses,
                            std::span<const Eigen::Vector3f> voxel_centres_m);
   // Poses against the map: loads the occupied voxels near each chunk of poses from the view.
+  // The body's pitch follows the terrain where the map has support under both ends of the body
+  // (a legged body stands on a stair flight at the flight's slope, whatever the trajectory's
+  // own slope there is, e.g. at rest); elsewhere the pose's pitch is kept.
   CollisionHit check_poses(const map::MapView& view, std::span<const BodyPose> poses);
+  // Terrain pitch under a pose: support heights half a body length ahead and behind (nearest
+  // to the foot height within the slope window); nullopt if either end has no support.
+  std::optional<double> terrain_pitch(const map::MapView& view, const BodyPose& p) const;
 
   // Control look-ahead: the trajectory pose_at(t) sampled over [t_from, t_from + horizon_s] at
   // dt_s (clamped so the body moves at most the sample spacing between samples, at the robot's
@@ -111,6 +118,7 @@ class CollisionChecker {
   double max_spacing_m_;
   std::unique_ptr<Impl> impl_;
   std::vector<BodyPose> samples_;
+  std::vector<BodyPose> adjusted_;
   std::vector<Eigen::Vector3f> centres_;
   std::vector<float> surface_z_;
 };

@@ -5,6 +5,7 @@
 #include <limits>
 #include <map>
 
+#include "core/plan/path_centring.hpp"
 #include "core/plan/plan_config.hpp"
 
 namespace storey::core::plan {
@@ -256,6 +257,8 @@ bool LocalPlanner::try_target(const LocalPlanInput& in, const Viewpoint& vp, Loc
   // the nearest collision-free pose, see free_start()). The B-spline is checked against the
   // body with FCL whichever path it follows.
   path.points_m.front() = start_foot_m_;
+  centre_path(*in.view, path.points_m);
+  align_before_climbs(*in.view, path.points_m);
   TrajectoryResult tr =
       builder_.build(*in.view, checker_, path.points_m, start_yaw_, vp.yaw_rad, in.t_s);
   if (tr.status != TrajectoryStatus::kOk && tr.status != TrajectoryStatus::kPolyline) {

@@ -6,6 +6,7 @@
 
 #include "core/graph/frontier_clusters.hpp"
 #include "core/graph/graph_export.hpp"
+#include "core/graph/support_query.hpp"
 #include "core/graph/topological_frontiers.hpp"
 #include "core/graph/viewpoint_generator.hpp"
 #include "tests/core_graph/graph_world.hpp"
@@ -285,4 +286,29 @@ TEST(GraphExport, JsonAndPlyDescribeTheGraph) {
   std::string err;
   EXPECT_FALSE(write_text_file("/nonexistent-dir/g.ply", ply, &err));
   EXPECT_NE(err.find("/nonexistent-dir/g.ply"), std::string::npos);
+}
+
+// C_exp up a stair flight (paper III-C): seen from the floor with the sensor at 0.55 m, the risers
+// are observed but the treads above the sensor are not. A probe at body height hits the second
+// riser; the climbing probe steps up the observed treads and reaches the unknown ones.
+TEST(TopologicalFrontiers, ProbeClimbsAStairFlightToItsUnknownTreads) {
+  World w;
+  w.add({-3.2f, -2, -0.3f}, {6, 2, 0.0f});
+  w.stairs(0.0f, -0.6f, 0.6f, 0.0f, 12, 0.17f, 0.29f);
+  w.add({0, -0.72f, 0}, {3.5f, -0.6f, 2.5f});  // side walls
+  w.add({0, 0.6f, 0}, {3.5f, 0.72f, 2.5f});
+  w.add({-3.2f, -2, 0}, {-3.0f, 2, 2.5f});  // a wall behind the robot
+  GraphOptions o;
+  Harness h(o);
+  h.observe(w, Vector3f(-1.5f, 0, 0.55f), Vector3f(-1.5f, 0, 0), 150000, 7, 6.0f);
+  SupportQuery q(h.map.view(), o);
+  const Vector3f foot(-0.3f, 0, 0);
+  const Eigen::Vector2f up(1, 0), back(-1, 0);
+  const float min_free = 0.2f;
+  // The level probe stops at a riser: closed.
+  EXPECT_FALSE(
+      q.probe_open(foot + Vector3f(0, 0, 0.3f), foot + Vector3f(3.0f, 0, 0.3f), min_free, 0.3f));
+  EXPECT_TRUE(q.probe_open_climbing(foot, up, 3.0f, 0.3f, min_free, 0.3f));
+  // Toward the observed wall behind: closed either way.
+  EXPECT_FALSE(q.probe_open_climbing(foot, back, 3.0f, 0.3f, min_free, 0.3f));
 }

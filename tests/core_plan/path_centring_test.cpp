@@ -1,0 +1,113 @@
+// Stage 3 path shaping before the B-spline (core/plan/path_centring.hpp): centring in passages,
+// run-ups before stair flights, and the collision checker's terrain pitch on a flight.
+#include "core/plan/path_centring.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "core/plan/collision_checker.hpp"
+#include "tests/core_plan/voxel_world.hpp"
+
+using namespace storey::core;
+using namespace storey::core::plan;
+using Eigen::Vector3d;
+using storey::test::aabb;
+
+namespace {
+
+// Floor, and a wall along x = 0 with a 1.0 m door (y in [-0.5, 0.5]).
+storey::test::World door_world() {
+  storey::test::World w;
+  w.add(aabb({-4, -3, -0.2f}, {4, 3, 0}));
+  w.add(aabb({-0.05f, -3, 0}, {0.05f, -0.5f, 2.2f}));
+  w.add(aabb({-0.05f, 0.5f, 0}, {0.05f, 3, 2.2f}));
+  return w;
+}
+
+// Floor, and a flight of 10 steps (0.15 m rise, 0.30 m tread) rising along +x from x = 0,
+// 1.2 m wide between side walls.
+storey::test::World stair_world() {
+  storey::test::World w;
+  w.add(aabb({-4, -3, -0.2f}, {6, 3, 0}));
+  w.stairs(0.0f, -0.6f, 0.6f, 0.0f, 10, 0.15f, 0.30f);
+  w.add(aabb({0, -0.72f, 0}, {3, -0.6f, 2.5f}));
+  w.add(aabb({0, 0.6f, 0}, {3, 0.72f, 2.5f}));
+  return w;
+}
+
+}  // namespace
+
+TEST(PathCentring, MovesPointsInADoorToItsMiddle) {
+  map::TraversabilityMap m;
+  storey::test::scan_world(m, door_world(), {{-1.5f, 0, 0.5f}, {1.5f, 0, 0.5f}});
+  const map::MapView view = m.view();
+  // A straight path through the door 0.3 m off its middle (0.2 m from the jamb).
+  std::vector<Vector3d> path;
+  for (double x = -1.5; x <= 1.5 + 1e-9; x += 0.1) path.emplace_back(x, 0.3, 0.0);
+  const std::vector<Vector3d> before = path;
+  const PathCentringStats st = centre_path(view, path);
+  EXPECT_GT(st.moved, 0);
+  EXPECT_LE(st.max_shift_m, 0.3 + 1e-9);
+  EXPECT_EQ(path.front(), before.front());
+  EXPECT_EQ(path.back(), before.back());
+  for (size_t i = 0; i < path.size(); ++i)
+    if (std::abs(path[i].x()) < 0.1) {
+      EXPECT_LT(std::abs(path[i].y()), 0.1) << "point in the door at x " << path[i].x();
+    }
+  // Far from the wall (open floor, clearance above half the body length) nothing moves.
+  for (size_t i = 1; i + 1 < path.size(); ++i)
+    if (std::abs(before[i].x()) > 1.0) {
+      EXPECT_EQ(path[i], before[i]);
+    }
+}
+
+TEST(PathCentring, RunUpBeforeAFlightIsOnItsAxis) {
+  map::TraversabilityMap m;
+  storey::test::scan_world(m, stair_world(), {{-1.5f, 0, 0.5f}, {-1.0f, 1.5f, 0.5f}});
+  const map::MapView view = m.view();
+  // Approaching the foot of the flight diagonally from the north-west, then up the first treads.
+  std::vector<Vector3d> path = {{-1.2, 1.6, 0},   {-0.8, 1.2, 0},   {-0.4, 0.8, 0},
+                                {-0.2, 0.5, 0},   {-0.1, 0.2, 0},   {0.1, 0.1, 0.15},
+                                {0.4, 0.05, 0.3}, {0.7, 0.0, 0.45}, {1.0, 0.0, 0.6}};
+  ASSERT_EQ(align_before_climbs(view, path), 1);
+  // The foot of the flight stays; right before it, one point a run-up (0.4 m: half the body
+  // length + margin) back along the flight's direction, and no approach point in between.
+  size_t foot = 0;
+  while (foot + 1 < path.size() && path[foot + 1].z() < 0.1) ++foot;
+  ASSERT_GE(foot, 1u);
+  EXPECT_NEAR(path[foot].x(), -0.1, 1e-9);
+  const Vector3d& run_up = path[foot - 1];
+  const double run = (path[foot] - run_up).head<2>().norm();
+  const RobotModel robot;
+  EXPECT_NEAR(run, 0.5 * robot.body_length_m + robot.body_margin_m, 1e-6);
+  // The flight rises along +x (slightly south in this path): the run-up lies west of the foot.
+  EXPECT_LT(run_up.x(), path[foot].x() - 0.35);
+  EXPECT_LT(std::abs(run_up.z()), 0.05);
+  // A path that stays level is left alone.
+  std::vector<Vector3d> level = {{-2, 0, 0}, {-1.5, 0, 0}, {-1, 0, 0}};
+  EXPECT_EQ(align_before_climbs(view, level), 0);
+  EXPECT_EQ(level.size(), 3u);
+}
+
+TEST(PathCentring, BodyAtRestOnAFlightTakesTheTerrainPitch) {
+  map::TraversabilityMap m;
+  storey::test::scan_world(m, stair_world(), {{-1.5f, 0, 0.5f}, {0.75f, 0, 0.95f}});
+  const map::MapView view = m.view();
+  CollisionChecker cc(RobotModel{}, view.voxel_size_m());
+  // Standing at the front of the third tread (top 0.45 m, x 0.6..0.9) facing up the flight,
+  // level (pitch 0: what a trajectory at rest reports): the fifth tread (0.30 m higher, 0.35 m
+  // ahead) would be inside a level box.
+  const BodyPose rest{{0.85, 0, 0.45}, 0.0, 0.0, 0.0};
+  const auto tp = cc.terrain_pitch(view, rest);
+  ASSERT_TRUE(tp.has_value());
+  EXPECT_NEAR(*tp, std::atan2(0.15, 0.30), 0.15);
+  EXPECT_FALSE(cc.check_poses(view, std::span<const BodyPose>(&rest, 1)).collides);
+  std::vector<Eigen::Vector3f> vox;
+  for (int i = 0; i < 10; ++i)
+    storey::test::fill_voxels(vox, {0.3f * i, -0.6f, -0.1f},
+                              {0.3f * (i + 1), 0.6f, 0.15f * (i + 1)});
+  EXPECT_TRUE(cc.check_poses(std::span<const BodyPose>(&rest, 1), vox).collides)
+      << "scenario: a level box on the flight should touch the treads ahead";
+}
