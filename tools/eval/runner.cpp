@@ -230,7 +230,10 @@ std::vector<RunOutcome> Runner::run(const std::vector<RunSpec>& specs) {
     posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
     posix_spawn_file_actions_addopen(&fa, 2, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     posix_spawn_file_actions_adddup2(&fa, 2, 1);
-    const int rc = posix_spawn(&r.pid, o_.storey.c_str(), &fa, nullptr, argv.data(), environ);
+    // Checked first: some posix_spawn implementations report a failed exec only as exit 127.
+    const int rc = access(o_.storey.c_str(), X_OK) != 0
+                       ? errno
+                       : posix_spawn(&r.pid, o_.storey.c_str(), &fa, nullptr, argv.data(), environ);
     posix_spawn_file_actions_destroy(&fa);
     if (rc != 0) {
       // Recorded like any failed run, so the rest of the matrix still runs.
