@@ -24,9 +24,9 @@ void take_trajectory(LocalPlanResult& lr, ExplorationResult& r) {
 
 const char* to_string(PlanStage s) {
   static constexpr const char* kNames[] = {
-      "floors",       "prior",    "hybrid_bind", "hybrid_check", "hybrid_compile",
-      "hybrid_zones", "global",   "local_keep",  "local_stage1", "local_stage2",
-      "local_stage3", "approach", "done"};
+      "floors",         "prior",        "prior_zones", "hybrid_bind", "hybrid_check",
+      "hybrid_compile", "hybrid_zones", "global",      "local_keep",  "local_stage1",
+      "local_stage2",   "local_stage3", "approach",    "done"};
   static_assert(sizeof(kNames) / sizeof(kNames[0]) == size_t(PlanStage::kCount));
   return size_t(s) < size_t(PlanStage::kCount) ? kNames[size_t(s)] : "?";
 }
@@ -106,19 +106,22 @@ void ExplorationPlanner::build_prior(const ExplorationInput& in, int32_t ref, in
   std::vector<uint32_t> index(g.node_capacity(), kNoNode);
   std::vector<Eigen::Vector3d> pos;
   std::vector<double> clear;
+  std::vector<Eigen::Vector3f> support;
   for (graph::NodeId i = 0; i < g.node_capacity(); ++i) {
     const graph::GraphNode& n = g.node(i);
     if (!n.alive || floors_.floor_of(n.p_m.z()) != ref) continue;
     index[i] = uint32_t(pos.size());
     pos.push_back(n.p_m.cast<double>());
-    clear.push_back(clearance_(*in.view, n.p_m));
+    support.push_back(n.p_m);
   }
+  clearance_(*in.view, support, clear);  // batched: columns shared between nodes
   std::vector<SearchGraph::Edge> edges;
   for (graph::EdgeId e = 0; e < g.edge_capacity(); ++e) {
     const graph::GraphEdge& ge = g.edge(e);
     if (!ge.alive || index[ge.a] == kNoNode || index[ge.b] == kNoNode) continue;
     edges.push_back({index[ge.a], index[ge.b], double(ge.length_m)});
   }
+  probe_mark(probe_, PlanStage::kPriorZones);
   const SearchGraph sg = SearchGraph::from_edges(pos, edges, true);
   const ZonePartition zones = partitioner_.partition(sg, clear, {opt_.r_z_m, opt_.min_zone_nodes});
   r.dz_m = floors_.dz(ref, target);

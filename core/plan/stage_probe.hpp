@@ -9,7 +9,8 @@ namespace storey::core::plan {
 
 enum class PlanStage : uint8_t {
   kFloors = 0,     // floor tracking and per-floor progress
-  kPrior,          // task zones on the reference floor + projection into G_hyp (IV-A)
+  kPrior,          // reference floor's graph + obstacle clearance per node (zone seeds, IV-A)
+  kPriorZones,     // task zones on the reference floor + projection into G_hyp (IV-A)
   kHybridBind,     // IV-B 1: real nodes absorb overlapping hypotheses
   kHybridCheck,    // IV-B 1: hypotheses and hypothetical edges against the new map
   kHybridCompile,  // G_real + G_hyp (+ bridges) -> CSR

@@ -1,8 +1,10 @@
 #include "core/plan/task_zones.hpp"
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 #include <limits>
+#include <tuple>
 
 namespace storey::core::plan {
 
@@ -132,6 +134,87 @@ double ObstacleClearance::operator()(const map::MapView& view, const Eigen::Vect
     for (int z = z_lo; z <= z_hi; ++z)
       if (view.is_occupied({base.x + o.dx, base.y + o.dy, z})) return o.dist_m;
   return max_radius_m_;
+}
+
+void ObstacleClearance::operator()(const map::MapView& view,
+                                   std::span<const Eigen::Vector3f> points,
+                                   std::vector<double>& out) {
+  const double v = view.voxel_size_m();
+  if (v != built_for_voxel_m_) build(v);
+  out.assign(points.size(), 0.0);
+  const RobotModel& robot = view.robot();
+  struct Key {
+    int32_t x, y, z_lo, z_hi;
+  };
+  std::vector<Key> keys(points.size());
+  order_.clear();
+  for (uint32_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3f& p = points[i];
+    if (!p.allFinite()) continue;  // 0, as the single-point query
+    const map::VoxelKey base = view.key_of(p);
+    keys[i] = {base.x, base.y,
+               view.key_of(p + Eigen::Vector3f(0, 0, float(robot.step_height_m + v * 0.5))).z,
+               view.key_of(p + Eigen::Vector3f(0, 0, float(robot.body_height_m))).z};
+    order_.push_back(i);
+  }
+  // Points sorted by band; a group spans at most 64 layers, one column memo per group holding
+  // the occupied layers of each column as a bit mask (points a few layers apart share it).
+  std::stable_sort(order_.begin(), order_.end(), [&](uint32_t a, uint32_t b) {
+    return std::tie(keys[a].z_lo, keys[a].z_hi) < std::tie(keys[b].z_lo, keys[b].z_hi);
+  });
+  const int32_t r = int32_t(std::ceil(max_radius_m_ / v));
+  constexpr size_t kMaxMemo = size_t(1) << 22;  // 4 M columns (40 MB); beyond: point by point
+  for (size_t b = 0; b < order_.size();) {
+    const int32_t z0 = keys[order_[b]].z_lo;
+    int32_t z1 = z0, x0 = INT32_MAX, x1 = INT32_MIN, y0 = INT32_MAX, y1 = INT32_MIN;
+    size_t e = b;
+    for (; e < order_.size() && keys[order_[e]].z_hi - z0 < 64; ++e) {
+      const Key& k = keys[order_[e]];
+      z1 = std::max(z1, k.z_hi);
+      x0 = std::min(x0, k.x - r);
+      x1 = std::max(x1, k.x + r);
+      y0 = std::min(y0, k.y - r);
+      y1 = std::max(y1, k.y + r);
+    }
+    if (e == b) {  // a band taller than 64 layers: on its own
+      out[order_[b]] = (*this)(view, points[order_[b]]);
+      ++b;
+      continue;
+    }
+    const size_t w = size_t(x1 - x0 + 1), h = size_t(y1 - y0 + 1);
+    if (w * h > kMaxMemo) {
+      for (size_t j = b; j < e; ++j) out[order_[j]] = (*this)(view, points[order_[j]]);
+      b = e;
+      continue;
+    }
+    mask_.assign(w * h, 0);
+    done_.assign(w * h, 0);
+    for (size_t j = b; j < e; ++j) {
+      const Key& k = keys[order_[j]];
+      // Layers z_lo..z_hi of this point as bits relative to z0.
+      const int n = k.z_hi - k.z_lo + 1;
+      const uint64_t band =
+          n <= 0 ? 0 : ((n >= 64 ? ~uint64_t(0) : (uint64_t(1) << n) - 1) << (k.z_lo - z0));
+      double c = max_radius_m_;
+      for (const Offset& o : offsets_) {
+        const int32_t x = k.x + o.dx, y = k.y + o.dy;
+        const size_t m = size_t(x - x0) + size_t(y - y0) * w;
+        if (!done_[m]) {
+          done_[m] = 1;
+          uint64_t bits = 0;
+          for (int32_t z = z0; z <= z1; ++z)
+            if (view.is_occupied({x, y, z})) bits |= uint64_t(1) << (z - z0);
+          mask_[m] = bits;
+        }
+        if (mask_[m] & band) {
+          c = o.dist_m;
+          break;
+        }
+      }
+      out[order_[j]] = c;
+    }
+    b = e;
+  }
 }
 
 }  // namespace storey::core::plan

@@ -69,9 +69,18 @@ class ObstacleClearance {
  public:
   explicit ObstacleClearance(double max_radius_m = 3.0) : max_radius_m_(max_radius_m) {}
   double operator()(const map::MapView& view, const Eigen::Vector3f& support_m);
+  // The same for many points (a floor's nodes): each column is looked up at most once per
+  // group of points within 64 layers (a floor), so a floor costs its columns x layers instead
+  // of points x pi (R/voxel)^2 x layers. out[i] == operator()(view, points[i]).
+  void operator()(const map::MapView& view, std::span<const Eigen::Vector3f> points,
+                  std::vector<double>& out);
 
  private:
   void build(double voxel_m);
+  // Column memo over a box of columns: occupied layers (bit i = layer z0 + i), evaluated yet.
+  std::vector<uint64_t> mask_;
+  std::vector<uint8_t> done_;
+  std::vector<uint32_t> order_;
   double max_radius_m_;
   double built_for_voxel_m_ = 0;
   struct Offset {

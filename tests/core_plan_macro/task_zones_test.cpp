@@ -4,6 +4,7 @@
 
 #include <set>
 
+#include "macro_world.hpp"
 #include "toy_graph.hpp"
 
 using namespace storey::core::plan;
@@ -133,4 +134,34 @@ TEST(TaskZones, DeterministicAndBadInputIsReported) {
   const ZonePartition bad = a.partition(g, short_clearance, {6.0, 4});
   EXPECT_TRUE(bad.zones.empty());
   EXPECT_EQ(a.bad_input(), 1u);
+}
+
+TEST(ObstacleClearance, BatchedEqualsPointByPoint) {
+  // Two rooms with a door, a staircase up to a landing: nodes on several height bands.
+  storey::test::macro::World w;
+  w.add({-1, -1, -0.2f}, {13, 6, 0});
+  w.add({6, 0, 0}, {6.2f, 2, 2.5f});
+  w.add({6, 3, 0}, {6.2f, 5, 2.5f});
+  w.add({-0.2f, -0.2f, 0}, {12.2f, 0, 2.5f});
+  w.stairs(8, 3, 4.5f, 0, 6, 0.15f, 0.3f);
+  storey::test::macro::Harness h;
+  h.observe(w, {3, 2.5f, 0}, 40000, 1);
+  h.observe(w, {9, 2.5f, 0}, 40000, 2);
+  std::vector<Eigen::Vector3f> pts;
+  for (storey::core::graph::NodeId i = 0; i < h.graph.node_capacity(); ++i)
+    if (h.graph.node(i).alive) pts.push_back(h.graph.node(i).p_m);
+  ASSERT_GT(pts.size(), 20u);
+  pts.push_back({9.5f, 4.0f, 0.6f});  // on the stairs' band
+  pts.push_back({3, 2.5f, std::numeric_limits<float>::quiet_NaN()});
+  const auto view = h.map.view();
+  ObstacleClearance single(2.0), batch(2.0);
+  std::vector<double> out;
+  batch(view, pts, out);
+  ASSERT_EQ(out.size(), pts.size());
+  bool some_wall = false;
+  for (size_t i = 0; i < pts.size(); ++i) {
+    EXPECT_EQ(out[i], single(view, pts[i])) << i;
+    some_wall = some_wall || out[i] < 2.0;
+  }
+  EXPECT_TRUE(some_wall);
 }
