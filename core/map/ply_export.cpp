@@ -1,5 +1,6 @@
 #include "core/map/ply_export.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdint>
 #include <cstring>
@@ -13,9 +14,11 @@ namespace {
 struct PlyVertex {
   float x, y, z;
   uint8_t r, g, b, state;
+  uint8_t reasons;  // VoxelStats::kReason* bits: why tau(v) is not S_trav
+  uint16_t points;  // N(v), saturated
 };
 #pragma pack(pop)
-static_assert(sizeof(PlyVertex) == 16, "PLY vertex layout");
+static_assert(sizeof(PlyVertex) == 19, "PLY vertex layout");
 
 PlyExportResult write(const std::vector<PlyVertex>& v, const std::string& path) {
   PlyExportResult res;
@@ -28,7 +31,7 @@ PlyExportResult write(const std::vector<PlyVertex>& v, const std::string& path) 
     << "element vertex " << v.size() << "\n"
     << "property float x\nproperty float y\nproperty float z\n"
     << "property uchar red\nproperty uchar green\nproperty uchar blue\n"
-    << "property uchar state\nend_header\n";
+    << "property uchar state\nproperty uchar reasons\nproperty ushort points\nend_header\n";
   f.write(reinterpret_cast<const char*>(v.data()), std::streamsize(v.size() * sizeof(PlyVertex)));
   if (!f) {
     res.error = "write to '" + path + "' failed";
@@ -42,9 +45,17 @@ PlyExportResult write(const std::vector<PlyVertex>& v, const std::string& path) 
 
 PlyExportResult write_ply_occupied(const MapView& map, const std::string& path) {
   std::vector<PlyVertex> v;
-  map.for_each_occupied([&](const VoxelKey& k, const Cell& c, const VoxelStats*) {
+  map.for_each_occupied([&](const VoxelKey& k, const Cell& c, const VoxelStats* st) {
     const Eigen::Vector3f p = map.centre_of(k);
-    PlyVertex pv{p.x(), p.y(), p.z(), 160, 160, 160, uint8_t(c.state)};
+    PlyVertex pv{p.x(),
+                 p.y(),
+                 p.z(),
+                 160,
+                 160,
+                 160,
+                 uint8_t(c.state),
+                 uint8_t(st ? st->reasons : 0),
+                 uint16_t(st ? std::min<uint32_t>(st->count, 65535u) : 0)};
     if (c.flags & Cell::kReachable) {
       pv.r = 40, pv.g = 90, pv.b = 230, pv.state = 4;
     } else if (c.state == TravState::kTraversable) {
@@ -64,7 +75,8 @@ PlyExportResult write_ply_reachable(const MapView& map, const std::string& path)
     if (!(c.flags & Cell::kReachable)) return;
     const Eigen::Vector3f p = map.centre_of(k);
     const float h = st && st->count ? p.z() + st->mean[2] : p.z() + 0.5f * s;
-    v.push_back(PlyVertex{p.x(), p.y(), h, 40, 90, 230, 4});
+    v.push_back(PlyVertex{p.x(), p.y(), h, 40, 90, 230, 4, 0,
+                          uint16_t(st ? std::min<uint32_t>(st->count, 65535u) : 0)});
   });
   return write(v, path);
 }

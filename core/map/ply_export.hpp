@@ -15,7 +15,9 @@ struct PlyExportResult {
 };
 
 // Binary little-endian PLY, one vertex per occupied voxel (centre, x y z float + r g b uchar,
-// plus `state` uchar: 0 none, 1 unobserved, 2 traversable, 3 untraversable, 4 reachable).
+// plus `state` uchar: 0 none, 1 unobserved, 2 traversable, 3 untraversable, 4 reachable;
+// `reasons` uchar: VoxelStats::kReason* bits, 1 not top, 2 collinear, 4 cost, 8 R_col, 16 R_fall;
+// `points` ushort: N(v)).
 PlyExportResult write_ply_occupied(const MapView& map, const std::string& path);
 // Only the members of C_reach, at their surface height.
 PlyExportResult write_ply_reachable(const MapView& map, const std::string& path);

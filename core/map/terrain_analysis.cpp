@@ -137,6 +137,12 @@ TravState TraversabilityMap::evaluate(const VoxelKey& k, VoxelStats* s) {
 
   // R_col(v): an occupied voxel whose points lie above the step height and below the body
   // clearance, within collision_radius_m of v's column.
+  // The height v's body would stand at: the top of v's points, estimated as mean + one standard
+  // deviation in z (within the voxel). At a stair's nosing the voxel also holds riser points
+  // below the tread, which pull the mean down; against the mean, the next tread (one 0.167 m
+  // rise up) would read higher than the 0.18 m step and block every nosing.
+  const double var_z = s->count ? std::max(0.0, double(s->m2[5]) / double(s->count)) : 0.0;
+  const double h_top = std::min(double(h_v) + std::sqrt(var_z), (double(k.z) + 1.0) * vs);
   const double clear = robot_.body_height_m + robot_.body_margin_m;
   const int rc2 = r_col_ * r_col_;
   for (int dx = -r_col_; dx <= r_col_ && !(s->reasons & VoxelStats::kReasonCollision); ++dx)
@@ -148,7 +154,7 @@ TravState TraversabilityMap::evaluate(const VoxelKey& k, VoxelStats* s) {
         const Cell* cw = rcell(w);
         if (!occupied(cw)) continue;
         const double dh =
-            surface_height(w, cw->stats == Cell::kNoStats ? nullptr : reader_.stats(w)) - h_v;
+            surface_height(w, cw->stats == Cell::kNoStats ? nullptr : reader_.stats(w)) - h_top;
         hit = dh > robot_.step_height_m && dh <= clear;
       }
       if (hit) {
