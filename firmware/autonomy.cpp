@@ -53,7 +53,8 @@ Autonomy::Autonomy(Platform& platform, const rt::Clock& clock, AutonomyOptions o
       clusters_(opt_.params.graph),
       viewpoints_(opt_.params.graph, opt_.fov),
       rng_(opt_.seed),
-      planner_(opt_.params.robot, opt_.params.plan, opt_.params.map.voxel_size_m),
+      policy_(make_exploration_policy(opt_.method, opt_.params)),
+      plan_q_(64),
       law_(opt_.params.robot),
       safety_(opt_.params.safety),
       lookahead_(opt_.params.robot, opt_.params.map.voxel_size_m),
@@ -63,6 +64,9 @@ Autonomy::Autonomy(Platform& platform, const rt::Clock& clock, AutonomyOptions o
     free_q_.try_push(&b);
   }
   drop_buf_.points_m.reserve(opt_.scan_reserve_points);
+  if (!policy_->local_layer())
+    idle_local_ = std::make_unique<core::plan::LocalPlanner>(opt_.params.robot, opt_.params.plan,
+                                                             opt_.params.map.voxel_size_m);
   rt::SchedulerOptions so;
   so.trace = &trace_;
   so.lockstep_event_hz = opt_.lockstep_event_hz;
@@ -175,12 +179,18 @@ void Autonomy::map_step() {
   const core::graph::FrontierUpdateStats fs = frontiers_.update(graph_, view, foot, changed_);
   const auto& clusters = clusters_.update(graph_);
   const auto& vps = viewpoints_.update(graph_, view, clusters);
+  ++map_cycle_;
+  // Changed regions travel with the world model until the plan task has consumed them.
+  const uint64_t seen = plan_seen_cycle_.load(std::memory_order_acquire);
+  std::erase_if(pending_changes_, [seen](const auto& c) { return c.first <= seen; });
+  for (const core::graph::Aabb& b : changed_)
+    if (!b.empty()) pending_changes_.push_back({map_cycle_, b});
   changed_.clear();
 
   // Publication allocates (an immutable copy is the price of lock-free readers); the old
   // versions are released by the telemetry task (Snapshot::collect), not here.
   auto w = std::make_shared<WorldModel>();
-  w->cycle = ++map_cycle_;
+  w->cycle = map_cycle_;
   w->stamp_s = now_s();
   w->map = map_.snapshot();
   w->graph = graph_;
@@ -189,6 +199,7 @@ void Autonomy::map_step() {
   w->settled = graph_.idle() && frontiers_.idle();
   w->frontier_nodes = fs.frontiers;
   w->scans = scans_inserted_;
+  w->changes = pending_changes_;
   world_.publish(std::shared_ptr<const WorldModel>(std::move(w)));
 }
 
@@ -219,7 +230,8 @@ void Autonomy::insert_startup_support(const Eigen::Vector3f& foot) {
   startup_points_ = pts.size();
 }
 
-// ---- plan (2 Hz): local layer (Stage 1-3) on the latest world model.
+// ---- plan (2 Hz): the exploration policy (the paper's ExplorationPlanner or a baseline) on the
+// latest world model; publishes its trajectory, holds, or ends the run.
 void Autonomy::plan_step() {
   if (suspended(kPlan)) return;
   const double now = now_s();
@@ -229,76 +241,162 @@ void Autonomy::plan_step() {
   if (!wv.ptr || pose_mb_.read(pose) == 0) return;
   const WorldModel& w = *wv.ptr;
   ++plan_cycles_;
-  if (replan_request_.exchange(false, std::memory_order_acq_rel)) planner_.drop_target();
+  if (replan_request_.exchange(false, std::memory_order_acq_rel)) policy_->drop_target();
+
+  // Regions changed since the previous call: every box of the map cycles after the last world
+  // model this task consumed (the map task keeps them until acknowledged).
+  plan_changes_.clear();
+  for (const auto& [cycle, box] : w.changes)
+    if (cycle > plan_last_cycle_) plan_changes_.push_back(box);
+  plan_last_cycle_ = w.cycle;
+  plan_seen_cycle_.store(w.cycle, std::memory_order_release);
 
   const core::map::MapView view = w.map->view();
-  core::plan::LocalPlanInput in;
+  core::plan::ExplorationInput in;
   in.view = &view;
+  in.map_version = w.map->version();
   in.graph = &w.graph;
   in.clusters = &w.clusters;
   in.viewpoints = &w.viewpoints;
   in.robot_foot_m = pose.position();
   in.robot_yaw_rad = pose.yaw_rad;
   in.t_s = now;
-  core::plan::LocalPlanResult r = planner_.plan(in);
+  in.changed_regions = &plan_changes_;
+  core::plan::ExplorationResult r = policy_->plan(in);
 
-  using core::plan::LocalPlanStatus;
+  using PS = core::plan::ExplorationStatus;
   auto publish = [&](std::shared_ptr<PlannedTrajectory> p) {
     p->id = ++traj_id_;
     p->stamp_s = now;
     traj_.publish(std::shared_ptr<const PlannedTrajectory>(std::move(p)));
   };
-  if (r.status == LocalPlanStatus::kNewTrajectory) {
-    auto p = std::make_shared<PlannedTrajectory>();
-    p->trajectory = std::move(r.trajectory);
-    p->real_until_s = r.real_until_s;
-    p->target_cluster = r.target_cluster;
-    p->target_m = r.target_m;
-    p->path_m = std::move(r.path_m);
-    publish(std::move(p));
-    ++trajectories_;
-    idle_since_s_ = -1;
-  } else if (r.status == LocalPlanStatus::kNoFrontiers ||
-             r.status == LocalPlanStatus::kNoReachableTarget) {
+  auto hold = [&] {  // an empty trajectory: the control task holds still
     const auto cur = traj_.read();
     if (cur.ptr && !cur.ptr->trajectory.empty()) publish(std::make_shared<PlannedTrajectory>());
-    if (idle_since_s_ < 0) idle_since_s_ = now;
-    // Complete: nothing reachable left to look at, and the graph has no work carried over
-    // that could still produce a frontier.
-    // For kNoReachableTarget every cluster must be set aside or unreachable (not merely
-    // failed once in this cycle).
-    const bool exhausted = r.status == LocalPlanStatus::kNoFrontiers ||
-                           r.clusters_set_aside + r.clusters_unreachable >= r.clusters_total;
-    if (!exhausted) idle_since_s_ = now;
-    // The graph's bounded per-cycle work can keep churning on sensor noise (a node appears and
-    // is pruned again) without ever yielding a reachable target: after a longer grace the
-    // exhausted planner alone decides.
-    const double idle_s = now - idle_since_s_;
-    if (w.graph.node_count() > 0 && ((w.settled && idle_s >= opt_.complete_after_s) ||
-                                     idle_s >= opt_.complete_unsettled_after_s))
-      complete_ = true;
-  } else if (r.status != LocalPlanStatus::kKeep) {
-    idle_since_s_ = -1;
-  }
-  if (r.status == LocalPlanStatus::kKeep || r.status == LocalPlanStatus::kNewTrajectory) {
-    idle_since_s_ = -1;
-    complete_ = false;
+  };
+  ExplorationStatus s;
+  if (r.floor_changed && r.floor >= 0)
+    plan_q_.try_push(PlanEvent{PlanEvent::kFloor, now, r.floor, r.reference_floor, r.dz_m, ""});
+  if (r.prior_built)
+    plan_q_.try_push(PlanEvent{PlanEvent::kPrior, now, r.floor, r.reference_floor, r.dz_m, ""});
+  if (r.status != PS::kFailed) last_failure_ = nullptr;
+  switch (r.status) {
+    case PS::kNewTrajectory: {
+      auto p = std::make_shared<PlannedTrajectory>();
+      p->trajectory = std::move(r.trajectory);
+      // Drive only the real prefix (Sec. IV-C); never past the curve's end.
+      p->real_until_s = std::min(r.real_until_s, p->trajectory.t_end());
+      p->target_cluster = r.target_cluster;
+      p->target_m = r.target_m;
+      publish(std::move(p));
+      ++trajectories_;
+      idle_since_s_ = -1;
+      complete_ = false;
+      break;
+    }
+    case PS::kKeep:
+      idle_since_s_ = -1;
+      complete_ = false;
+      break;
+    case PS::kExploring:
+      // No target this cycle while the map grows: the control task finishes (or holds the end
+      // of) the current trajectory, as before a target exists. Not idle: completion needs the
+      // policy itself to say so.
+      idle_since_s_ = -1;
+      break;
+    case PS::kFailed:
+      hold();
+      idle_since_s_ = -1;
+      if (r.reason != last_failure_)  // once per distinct reason, not every cycle
+        plan_q_.try_push(PlanEvent{PlanEvent::kFailed, now, r.floor, -1, 0, r.reason});
+      last_failure_ = r.reason;
+      break;
+    case PS::kComplete: {
+      hold();
+      if (idle_since_s_ < 0) idle_since_s_ = now;
+      // A one-cycle kComplete while the map still grows must not end the run: every cluster
+      // must be set aside by the local layer or unreachable through G_real (not merely failed
+      // once in Stage 3 this cycle), and then the graph must have settled for
+      // complete_after_s, or the exhausted state must have lasted complete_unsettled_after_s
+      // (the graph's bounded per-cycle work can churn on sensor noise without ever yielding a
+      // reachable target).
+      count_exhausted(w, s);
+      const bool exhausted = s.clusters_set_aside + s.clusters_unreachable >= w.clusters.size();
+      if (!exhausted) idle_since_s_ = now;
+      const double idle_s = now - idle_since_s_;
+      const bool was_complete = complete_;
+      if (w.graph.node_count() > 0 && ((w.settled && idle_s >= opt_.complete_after_s) ||
+                                       idle_s >= opt_.complete_unsettled_after_s))
+        complete_ = true;
+      if (complete_ && !was_complete)
+        plan_q_.try_push(PlanEvent{PlanEvent::kComplete, now, r.floor, -1, 0, r.reason});
+      break;
+    }
   }
 
-  ExplorationStatus s;
   s.stamp_s = now;
   s.state = complete_ ? ExplorationState::kComplete : ExplorationState::kExploring;
+  s.method = policy_->name();
   s.last_plan = r.status;
+  s.plan_reason = r.reason;
   s.nodes = uint32_t(w.graph.node_count());
   s.edges = uint32_t(w.graph.edge_count());
   s.frontier_nodes = w.frontier_nodes;
   s.clusters = uint32_t(w.clusters.size());
-  s.clusters_set_aside = uint32_t(r.clusters_set_aside);
-  s.clusters_unreachable = uint32_t(r.clusters_unreachable);
   s.trajectories = trajectories_;
   s.plan_cycles = plan_cycles_;
   s.floor_hint = int(std::lround(pose.z_m / opt_.params.graph.floor_height_hint_m));
+  s.floor = r.floor;
+  s.guided = r.guided;
+  s.zones_deferred = uint32_t(std::max(0, r.zones_deferred));
+  if (const core::plan::ExplorationPlanner* macro = policy_->macro_layer()) {
+    s.floors_known = uint32_t(macro->floors().floors().size());
+    const core::plan::HybridGraph& h = macro->hybrid();
+    s.prior = h.has_prior();
+    if (s.prior) {
+      s.zones = uint32_t(h.zones().size());
+      for (const core::plan::HybridZone& z : h.zones())
+        s.zones_left += z.state != core::plan::ZoneState::kCompleted;
+    }
+    if (r.prior_built) prior_dz_m_ = r.dz_m, prior_reference_ = r.reference_floor;
+    s.prior_dz_m = prior_dz_m_;
+    s.reference_floor = s.prior ? prior_reference_ : -1;
+  }
   status_mb_.write(s);
+}
+
+// Clusters the local layer has set aside entirely, and clusters with no node connected to the
+// robot's node through real (confirmed or tentative) edges: the two ways a frontier cluster left
+// on the map is exhausted (LocalPlanner Stage 1 counts them the same way).
+void Autonomy::count_exhausted(const WorldModel& w, ExplorationStatus& s) {
+  const core::graph::ReachableGraph& g = w.graph;
+  const core::plan::LocalPlanner& local = planner_for_record();
+  std::vector<uint32_t>& parent = uf_scratch_;
+  parent.resize(g.node_capacity());
+  for (uint32_t i = 0; i < parent.size(); ++i) parent[i] = i;
+  auto find = [&](uint32_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  for (size_t e = 0; e < g.edge_capacity(); ++e) {
+    const core::graph::GraphEdge& ge = g.edge(core::graph::EdgeId(e));
+    if (!ge.alive || ge.state == core::graph::ElementState::kHypothetical) continue;
+    parent[find(ge.a)] = find(ge.b);
+  }
+  const bool rooted = g.root() != core::graph::kNoId && g.root() < parent.size();
+  const uint32_t root = rooted ? find(g.root()) : 0;
+  for (const core::graph::FrontierCluster& c : w.clusters) {
+    bool open = false, connected = false;
+    for (core::graph::NodeId n : c.nodes) {
+      if (local.set_aside_at(g.node(n).p_m)) continue;
+      open = true;
+      connected = connected || (rooted && find(n) == root);
+    }
+    if (!open)
+      ++s.clusters_set_aside;
+    else if (!connected)
+      ++s.clusters_unreachable;
+  }
 }
 
 // ---- control (50 Hz): odometry in, tracking, FCL look-ahead, safety, command out.
@@ -421,10 +519,30 @@ void Autonomy::watchdog_step() {
 void Autonomy::telemetry_step() {
   if (suspended(kTelemetry)) return;
   StopEvent e;
-  char line[160];
+  char line[256];
   while (stop_q_.try_pop(e)) {
     std::snprintf(line, sizeof line, "t=%.2f s: safety stop %s: %s", e.t_s,
                   e.raised ? "raised" : "cleared", to_string(e.reason));
+    log(line);
+  }
+  PlanEvent p;
+  while (plan_q_.try_pop(p)) {
+    switch (p.kind) {
+      case PlanEvent::kFloor:
+        std::snprintf(line, sizeof line, "t=%.2f s: on floor %d", p.t_s, p.floor);
+        break;
+      case PlanEvent::kPrior:
+        std::snprintf(line, sizeof line,
+                      "t=%.2f s: prior built for floor %d from floor %d (dz %.2f m)", p.t_s,
+                      p.floor, p.reference_floor, p.dz_m);
+        break;
+      case PlanEvent::kFailed:
+        std::snprintf(line, sizeof line, "t=%.2f s: planner failed: %s", p.t_s, p.reason);
+        break;
+      case PlanEvent::kComplete:
+        std::snprintf(line, sizeof line, "t=%.2f s: exploration complete: %s", p.t_s, p.reason);
+        break;
+    }
     log(line);
   }
   world_.collect();

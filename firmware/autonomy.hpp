@@ -13,6 +13,8 @@
 //   control -> *        command: Mailbox<VelocityCommand>; stop events: SpscQueue -> telemetry
 //   watchdog-> control  overrun flag: atomic
 //   plan    -> *        exploration status: Mailbox<ExplorationStatus>
+//   plan    -> telemetry plan events (floor, prior, failure, completion): SpscQueue
+//   plan    -> map      last world cycle whose changed regions the planner consumed: atomic
 // The map task is the only owner of the world model; everybody else reads immutable snapshots.
 #include <atomic>
 #include <cstdint>
@@ -31,8 +33,10 @@
 #include "core/plan/collision_checker.hpp"
 #include "core/plan/local_planner.hpp"
 #include "firmware/control_law.hpp"
+#include "firmware/exploration_policy.hpp"
 #include "firmware/platform.hpp"
 #include "firmware/safety_monitor.hpp"
+#include "firmware/world_model.hpp"
 #include "rt/mailbox.hpp"
 #include "rt/scheduler.hpp"
 #include "rt/snapshot.hpp"
@@ -40,19 +44,6 @@
 #include "rt/trace.hpp"
 
 namespace storey::firmware {
-
-// What the map task publishes each cycle (immutable once published).
-struct WorldModel {
-  uint64_t cycle = 0;
-  double stamp_s = 0;
-  std::shared_ptr<const core::map::MapSnapshot> map;
-  core::graph::ReachableGraph graph;
-  std::vector<core::graph::FrontierCluster> clusters;
-  std::vector<core::graph::ClusterViewpoints> viewpoints;
-  bool settled = false;  // graph and frontier work queues empty (nothing carried over)
-  uint32_t frontier_nodes = 0;
-  uint64_t scans = 0;  // scans inserted so far
-};
 
 // What the plan task publishes: the trajectory to track (empty = hold still).
 struct PlannedTrajectory {
@@ -71,13 +62,37 @@ enum class ExplorationState : uint8_t { kStarting = 0, kExploring, kComplete };
 struct ExplorationStatus {
   double stamp_s = 0;
   ExplorationState state = ExplorationState::kStarting;
-  core::plan::LocalPlanStatus last_plan = core::plan::LocalPlanStatus::kNoRobotNode;
+  const char* method = "";  // the policy's name (exploration_policy.hpp)
+  // The policy's last answer and why (string literals of core/: safe to copy).
+  core::plan::ExplorationStatus last_plan = core::plan::ExplorationStatus::kExploring;
+  const char* plan_reason = "";
   uint32_t nodes = 0, edges = 0, frontier_nodes = 0, clusters = 0;
+  // Clusters whose every node the local layer set aside / with no node connected to the robot
+  // through G_real (computed by the plan task when the policy has nothing to do).
   uint32_t clusters_set_aside = 0, clusters_unreachable = 0;
   uint64_t trajectories = 0, plan_cycles = 0;
   int floor_hint = 0;  // round(robot z / floor_height_hint_m)
+  // Macro layer (storey method; -1 / 0 for the baselines): the robot's floor and its reference
+  // floor (FloorTracker indices, in order of arrival), floors known, the prior (built once per
+  // new floor, dz = target - reference), its task zones (total, uncompleted, left out of the
+  // last global TSP) and whether global guidance chose this cycle's clusters or goal.
+  int32_t floor = -1, reference_floor = -1;
+  uint32_t floors_known = 0;
+  bool prior = false;
+  double prior_dz_m = 0;
+  uint32_t zones = 0, zones_left = 0, zones_deferred = 0;
+  bool guided = false;
 };
 const char* to_string(ExplorationState s);
+
+// Plan task -> telemetry (non-RT log): floor changes, prior built, failures, completion.
+struct PlanEvent {
+  enum Kind : uint8_t { kFloor = 0, kPrior, kFailed, kComplete } kind = kFloor;
+  double t_s = 0;
+  int32_t floor = -1, reference_floor = -1;
+  double dz_m = 0;
+  const char* reason = "";  // string literal
+};
 
 struct StopEvent {
   double t_s = 0;
@@ -92,6 +107,9 @@ struct AutonomyOptions {
   // Budget overruns stop the robot (DESIGN §3). Off in lockstep: there the virtual clock does
   // not wait for a slow task, and wall-time overruns would make the run non-deterministic.
   bool stop_on_overruns = true;
+  // Exploration policy (exploration_policy.hpp): storey | nearest-frontier | fael-like |
+  // tare-like. Unknown names throw std::invalid_argument from the constructor.
+  std::string method = "storey";
   double complete_after_s = 3.0;  // no target for this long with a settled graph = complete
   double complete_unsettled_after_s = 10.0;  // ... or this long while the graph still churns
   // Ground under the robot at start-up, which the LiDAR cannot see, entered as support up to
@@ -137,8 +155,12 @@ class Autonomy {
   // Owner-side views for the run record, only while no task runs (after the lockstep loop or
   // stop()): the live map (PLY export, coverage).
   const core::map::TraversabilityMap& map_for_record() const { return map_; }
-  // The local planner (set-aside frontier nodes and their reasons, for the run record).
-  const core::plan::LocalPlanner& planner_for_record() const { return planner_; }
+  // The storey method's local layer (set-aside frontier nodes and their reasons, for the run
+  // record); for a baseline policy an idle local planner (nothing set aside).
+  const core::plan::LocalPlanner& planner_for_record() const {
+    return policy_->local_layer() ? *policy_->local_layer() : *idle_local_;
+  }
+  const ExplorationPolicy& policy() const { return *policy_; }
 
  private:
   enum Task { kIngest = 0, kMap, kPlan, kControl, kWatchdog, kTelemetry, kTaskCount };
@@ -149,6 +171,7 @@ class Autonomy {
   void map_step();
   void insert_startup_support(const Eigen::Vector3f& foot);
   void plan_step();
+  void count_exhausted(const WorldModel& w, ExplorationStatus& s);
   void control_step();
   void watchdog_step();
   void telemetry_step();
@@ -176,13 +199,23 @@ class Autonomy {
   core::graph::ViewpointGenerator viewpoints_;
   std::mt19937_64 rng_;
   std::vector<core::graph::Aabb> changed_;
+  std::vector<std::pair<uint64_t, core::graph::Aabb>> pending_changes_;  // not yet seen by plan
   uint64_t map_cycle_ = 0, scans_inserted_ = 0;
   bool startup_support_done_ = false;
   size_t startup_points_ = 0;
   rt::Snapshot<WorldModel> world_;
 
   // plan task
-  core::plan::LocalPlanner planner_;
+  std::unique_ptr<ExplorationPolicy> policy_;
+  std::unique_ptr<core::plan::LocalPlanner> idle_local_;  // planner_for_record() for baselines
+  std::atomic<uint64_t> plan_seen_cycle_{0};  // plan -> map: changes up to here were consumed
+  uint64_t plan_last_cycle_ = 0;
+  std::vector<core::graph::Aabb> plan_changes_;
+  rt::SpscQueue<PlanEvent> plan_q_;
+  const char* last_failure_ = nullptr;
+  double prior_dz_m_ = 0;
+  int32_t prior_reference_ = -1;
+  std::vector<uint32_t> uf_scratch_;
   rt::Snapshot<PlannedTrajectory> traj_;
   rt::Mailbox<double> plan_alive_mb_;
   rt::Mailbox<ExplorationStatus> status_mb_;

@@ -1,0 +1,43 @@
+#include "firmware/exploration_policy.hpp"
+
+#include <stdexcept>
+
+namespace storey::firmware {
+
+namespace {
+
+// The paper's method: the macro layer over the local layer (exploration_planner.hpp).
+class StoreyPolicy final : public ExplorationPolicy {
+ public:
+  explicit StoreyPolicy(const config::Parameters& p)
+      : planner_(p.robot, p.plan, p.map.voxel_size_m) {}
+  const char* name() const override { return "storey"; }
+  core::plan::ExplorationResult plan(const core::plan::ExplorationInput& in) override {
+    return planner_.plan(in);
+  }
+  void drop_target() override { planner_.local().drop_target(); }
+  const core::plan::LocalPlanner* local_layer() const override {
+    return &const_cast<core::plan::ExplorationPlanner&>(planner_).local();
+  }
+  const core::plan::ExplorationPlanner* macro_layer() const override { return &planner_; }
+
+ private:
+  core::plan::ExplorationPlanner planner_;
+};
+
+}  // namespace
+
+const std::vector<std::string>& exploration_methods() {
+  static const std::vector<std::string> m = {"storey", "nearest-frontier", "fael-like",
+                                             "tare-like"};
+  return m;
+}
+
+std::unique_ptr<ExplorationPolicy> make_exploration_policy(const std::string& method,
+                                                           const config::Parameters& params) {
+  if (method == "storey") return std::make_unique<StoreyPolicy>(params);
+  throw std::invalid_argument("exploration method '" + method +
+                              "': unknown (known: storey, nearest-frontier, fael-like, tare-like)");
+}
+
+}  // namespace storey::firmware
