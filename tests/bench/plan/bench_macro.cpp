@@ -164,6 +164,7 @@ void BM_MacroPlanCycle(benchmark::State& st) {
   std::vector<double> ms, cpu_ms;
   size_t hybrid_nodes = 0;
   int zones = 0, new_traj = 0;
+  int target_cluster = -1, zone0 = -1, zone1 = -1, zone2 = -1;  // the decision (same every cycle here)
   for (auto _ : st) {
     s.planner->local().drop_target();  // force a full replan (Stage 1-3) every cycle
     const auto view = s.h.map.view();
@@ -188,6 +189,10 @@ void BM_MacroPlanCycle(benchmark::State& st) {
     hybrid_nodes = s.planner->hybrid().nodes().size();
     zones = int(r.zones.size());
     new_traj += r.status == ExplorationStatus::kNewTrajectory;
+    target_cluster = r.target_cluster;
+    zone0 = r.zone_sequence.empty() ? -1 : r.zone_sequence[0];
+    zone1 = r.zone_sequence.size() < 2 ? -1 : r.zone_sequence[1];
+    zone2 = r.zone_sequence.size() < 3 ? -1 : r.zone_sequence[2];
   }
   s.planner->set_stage_probe(nullptr);
   st.counters["p50_ms"] = percentile(ms, 0.5);
@@ -207,6 +212,10 @@ void BM_MacroPlanCycle(benchmark::State& st) {
   st.counters["real_nodes"] = double(s.h.graph.node_count());
   st.counters["hybrid_nodes"] = double(hybrid_nodes);
   st.counters["zones"] = zones;
+  st.counters["target_cluster"] = target_cluster;
+  st.counters["zone_seq_0"] = zone0;
+  st.counters["zone_seq_1"] = zone1;
+  st.counters["zone_seq_2"] = zone2;
   st.counters["clusters"] = double(s.h.clusters.clusters().size());
   st.counters["new_traj_frac"] = double(new_traj) / double(ms.size());
 }
