@@ -164,7 +164,8 @@ void BM_MacroPlanCycle(benchmark::State& st) {
   std::vector<double> ms, cpu_ms;
   size_t hybrid_nodes = 0;
   int zones = 0, new_traj = 0;
-  int target_cluster = -1, zone0 = -1, zone1 = -1, zone2 = -1;  // the decision (same every cycle here)
+  int target_cluster = -1, zone0 = -1, zone1 = -1,
+      zone2 = -1;  // the decision (same every cycle here)
   for (auto _ : st) {
     s.planner->local().drop_target();  // force a full replan (Stage 1-3) every cycle
     const auto view = s.h.map.view();
