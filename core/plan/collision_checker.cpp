@@ -109,7 +109,7 @@ void CollisionChecker::load_voxels(std::span<const Eigen::Vector3f> centres,
 
 double CollisionChecker::ground_floor_z(const BodyPose& p) const {
   const double half_diag = 0.5 * std::hypot(box_m_.x(), box_m_.y());
-  return p.foot_m.z() + robot_.step_height_m * std::cos(p.pitch_rad) -
+  return p.foot_m.z() + (robot_.step_height_m + opt_.ground_tolerance_m) * std::cos(p.pitch_rad) -
          half_diag * std::abs(std::sin(p.pitch_rad));
 }
 
@@ -119,7 +119,8 @@ bool CollisionChecker::collide_one(const BodyPose& p, Eigen::Vector3d* voxel) {
   const Eigen::Matrix3d r = body_rotation(p);
   im.body->setTransform(r, p.foot_m + r * Eigen::Vector3d(0, 0, 0.5 * box_m_.z()));
   im.body->computeAABB();
-  QueryData q{im.body.get(), im.surface_z.data(), r, p.foot_m, robot_.step_height_m};
+  QueryData q{im.body.get(), im.surface_z.data(), r, p.foot_m,
+              robot_.step_height_m + opt_.ground_tolerance_m};
   im.manager.collide(im.body.get(), &q, on_pair);
   if (q.hit && voxel) *voxel = q.voxel;
   return q.hit;
@@ -158,16 +159,21 @@ namespace {
 constexpr double kMinTerrainPitchRad = 0.1;
 }  // namespace
 
-std::optional<double> CollisionChecker::terrain_pitch(const map::MapView& view,
-                                                      const BodyPose& p) const {
+std::optional<double> CollisionChecker::terrain_pitch(const map::MapView& view, const BodyPose& p,
+                                                      double* mid_z) const {
   const double half = 0.5 * robot_.body_length_m;
   const Eigen::Vector3d fwd(std::cos(p.yaw_rad), std::sin(p.yaw_rad), 0);
   // Slope window: the body's half length at 40 deg plus a step.
   const double window = half * 0.84 + robot_.step_height_m;
   const auto front = view.support_surface_near((p.foot_m + half * fwd).cast<float>(), window);
   const auto back = view.support_surface_near((p.foot_m - half * fwd).cast<float>(), window);
-  if (!front || !back) return std::nullopt;
-  return std::atan2(double(front->height_m) - double(back->height_m), 2.0 * half);
+  // An end without observed support (the LiDAR's blind ring around the robot) stands at the
+  // foot's height: the legs are on the ground the robot stands on.
+  if (!front && !back) return std::nullopt;
+  const double zf = front ? double(front->height_m) : p.foot_m.z();
+  const double zb = back ? double(back->height_m) : p.foot_m.z();
+  if (mid_z) *mid_z = 0.5 * (zf + zb);
+  return std::atan2(zf - zb, 2.0 * half);
 }
 
 CollisionHit CollisionChecker::check_poses(const map::MapView& view,
@@ -175,8 +181,11 @@ CollisionHit CollisionChecker::check_poses(const map::MapView& view,
   adjusted_.assign(in_poses.begin(), in_poses.end());
   for (BodyPose& p : adjusted_)
     if (finite(p))
-      if (const auto tp = terrain_pitch(view, p); tp && std::abs(*tp) >= kMinTerrainPitchRad)
+      if (double mid = 0; const auto tp = terrain_pitch(view, p, &mid)) {
+        if (std::abs(*tp) < kMinTerrainPitchRad) continue;
         p.pitch_rad = *tp;
+        p.foot_m.z() = std::max(p.foot_m.z(), mid);
+      }
   const std::span<const BodyPose> poses(adjusted_);
   CollisionHit h;
   const double half_diag = 0.5 * std::hypot(box_m_.x(), box_m_.y());

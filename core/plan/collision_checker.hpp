@@ -41,6 +41,10 @@ struct BodyPose {
 struct CollisionOptions {
   double sample_spacing_m = 0;  // 0 = max_sample_spacing_m(); larger values are clamped to it
   double chunk_extent_m = 3.0;  // samples are grouped so each group's voxel box stays this small
+  // Map surface heights are point means in 0.1 m voxels: a 0.167 m stair riser reads up to a
+  // few cm higher at a nosing. Obstacles start this far above the step height (the graph's
+  // surface_tolerance_m plays the same role for its edges).
+  double ground_tolerance_m = 0.03;
 };
 
 struct CollisionHit {
@@ -67,11 +71,16 @@ class CollisionChecker {
   // Poses against the map: loads the occupied voxels near each chunk of poses from the view.
   // The body's pitch follows the terrain where the map has support under both ends of the body
   // (a legged body stands on a stair flight at the flight's slope, whatever the trajectory's
-  // own slope there is, e.g. at rest); elsewhere the pose's pitch is kept.
+  // own slope there is, e.g. at rest), its bottom centre no lower than the mean of the two
+  // supports (with the front feet on a tread, the rear of the box would otherwise dip into the
+  // floor); elsewhere the pose's pitch is kept.
   CollisionHit check_poses(const map::MapView& view, std::span<const BodyPose> poses);
   // Terrain pitch under a pose: support heights half a body length ahead and behind (nearest
-  // to the foot height within the slope window); nullopt if either end has no support.
-  std::optional<double> terrain_pitch(const map::MapView& view, const BodyPose& p) const;
+  // to the foot height within the slope window; an end without support is taken at the foot's
+  // height); nullopt if neither end has support.
+  // `mid_z`: their mean, the height the body's bottom centre rests at on that slope.
+  std::optional<double> terrain_pitch(const map::MapView& view, const BodyPose& p,
+                                      double* mid_z = nullptr) const;
 
   // Control look-ahead: the trajectory pose_at(t) sampled over [t_from, t_from + horizon_s] at
   // dt_s (clamped so the body moves at most the sample spacing between samples, at the robot's

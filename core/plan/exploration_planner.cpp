@@ -135,10 +135,9 @@ bool ExplorationPlanner::drive_to(const ExplorationInput& in, const Eigen::Vecto
   VoxelPath path = astar_.plan(*in.view, in.robot_foot_m, goal);
   if (path.status != VoxelAStarStatus::kOk || path.points_m.empty()) return false;
   path.points_m.front() = in.robot_foot_m;
-  centre_path(*in.view, path.points_m);
-  align_before_climbs(*in.view, path.points_m);
   const Eigen::Vector2d d = (goal - in.robot_foot_m).head<2>();
-  const double yaw = d.norm() > 1e-6 ? std::atan2(d.y(), d.x()) : in.robot_yaw_rad;
+  const double yaw = shape_path(*in.view, path.points_m,
+                                d.norm() > 1e-6 ? std::atan2(d.y(), d.x()) : in.robot_yaw_rad);
   TrajectoryResult tr =
       builder_.build(*in.view, checker_, path.points_m, in.robot_yaw_rad, yaw, in.t_s);
   if (tr.status != TrajectoryStatus::kOk && tr.status != TrajectoryStatus::kPolyline) return false;

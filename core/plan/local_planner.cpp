@@ -257,20 +257,20 @@ bool LocalPlanner::try_target(const LocalPlanInput& in, const Viewpoint& vp, Loc
   // the nearest collision-free pose, see free_start()). The B-spline is checked against the
   // body with FCL whichever path it follows.
   path.points_m.front() = start_foot_m_;
-  centre_path(*in.view, path.points_m);
-  align_before_climbs(*in.view, path.points_m);
+  double goal_yaw = shape_path(*in.view, path.points_m, vp.yaw_rad);
   TrajectoryResult tr =
-      builder_.build(*in.view, checker_, path.points_m, start_yaw_, vp.yaw_rad, in.t_s);
+      builder_.build(*in.view, checker_, path.points_m, start_yaw_, goal_yaw, in.t_s);
   if (tr.status != TrajectoryStatus::kOk && tr.status != TrajectoryStatus::kPolyline) {
     if (on_graph || !graph_path()) return false;
-    tr = builder_.build(*in.view, checker_, path.points_m, start_yaw_, vp.yaw_rad, in.t_s);
+    goal_yaw = shape_path(*in.view, path.points_m, vp.yaw_rad);
+    tr = builder_.build(*in.view, checker_, path.points_m, start_yaw_, goal_yaw, in.t_s);
     if (tr.status != TrajectoryStatus::kOk && tr.status != TrajectoryStatus::kPolyline)
       return false;
   }
   out.trajectory = std::move(tr.trajectory);
   out.path_m = std::move(path.points_m);
   out.target_m = vp.p_m;
-  out.target_yaw_rad = vp.yaw_rad;
+  out.target_yaw_rad = goal_yaw;
   out.real_until_s = out.trajectory.t_end();  // the local layer plans on G_real only
   return true;
 }

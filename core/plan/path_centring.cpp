@@ -39,6 +39,11 @@ PathCentringStats centre_path(const map::MapView& view, std::vector<Eigen::Vecto
   const std::vector<Eigen::Vector3d> original = points;
   for (size_t i = 1; i + 1 < n; ++i) {
     const Eigen::Vector3d p = original[i];
+    // On a flight (a neighbour a level away) the treads ahead would read as obstacles: the
+    // flight's own shaping (shape_flights) centres it.
+    if (std::abs(original[i - 1].z() - p.z()) > 0.5 * r.step_height_m ||
+        std::abs(original[i + 1].z() - p.z()) > 0.5 * r.step_height_m)
+      continue;
     const int32_t cx = int32_t(std::floor(p.x() / s)), cy = int32_t(std::floor(p.y() / s));
     // Obstacle columns around the point, at its own level (stairs: each tread has its own band).
     obstacles.clear();
@@ -87,52 +92,183 @@ PathCentringStats centre_path(const map::MapView& view, std::vector<Eigen::Vecto
   return st;
 }
 
-int align_before_climbs(const map::MapView& view, std::vector<Eigen::Vector3d>& points,
-                        double climb_look_m) {
+namespace {
+
+bool clear_disc(const map::MapView& view, const Eigen::Vector2d& c, double h, double radius) {
+  const double s = view.voxel_size_m();
+  const int rv = int(std::ceil(radius / s));
+  const int32_t cx = int32_t(std::floor(c.x() / s)), cy = int32_t(std::floor(c.y() / s));
+  for (int dx = -rv; dx <= rv; ++dx)
+    for (int dy = -rv; dy <= rv; ++dy)
+      if ((dx * dx + dy * dy) * s * s <= radius * radius && obstacle_at(view, cx + dx, cy + dy, h))
+        return false;
+  return true;
+}
+
+// Height change of the support `dist` ahead of p along d (nearest to the expected height on a
+// 30 deg flight), or NaN if there is none.
+double gain_along(const map::MapView& view, const Eigen::Vector3d& p, const Eigen::Vector2d& d,
+                  double dist, double sign) {
+  const Eigen::Vector2d q = p.head<2>() + dist * d;
+  const double expect = p.z() + sign * dist * 0.58;
+  const auto sp = view.support_surface_near(
+      Eigen::Vector3f(float(q.x()), float(q.y()), float(expect)), 0.5 * dist * 0.58 + 0.1);
+  return sp ? double(sp->height_m) - p.z() : NAN;
+}
+
+}  // namespace
+
+// The flight's axis at its foot p: the direction of travel (within 60 deg of the path's own
+// direction `hint`) along which the support rises (sign +1) or falls (-1) the most over the next
+// 0.6 and 0.9 m; the weighted mean of the directions within 80 % of the best gain, so a 1.2 m
+// wide flight reads as its axis rather than a diagonal. Then the axis line is moved sideways to
+// the middle between the side walls (or the body's half width + margin off a single wall).
+std::optional<FlightAxis> flight_axis(const map::MapView& view, const Eigen::Vector3d& foot,
+                                      const Eigen::Vector2d& hint, double sign) {
+  constexpr int kDirs = 72;
+  double gains[kDirs];
+  auto dir_of = [](int k) {
+    const double th = 2.0 * M_PI * k / kDirs;
+    return Eigen::Vector2d(std::cos(th), std::sin(th));
+  };
+  for (int k = 0; k < kDirs; ++k) {
+    const Eigen::Vector2d d = dir_of(k);
+    const double g1 = sign * gain_along(view, foot, d, 0.6, sign);
+    const double g2 = sign * gain_along(view, foot, d, 0.9, sign);
+    gains[k] = g1 > 0 && g2 > 0 ? g1 + g2 : 0.0;  // NaN or not climbing: 0
+  }
+  // Best direction within 60 deg of the hint; then the gain-weighted mean of the directions
+  // within 80 % of its gain and 70 deg of it, on both sides (the gain is symmetric about the
+  // axis of a straight flight).
+  int best_k = -1;
+  for (int k = 0; k < kDirs; ++k)
+    if (dir_of(k).dot(hint) >= 0.5 && gains[k] > 0 && (best_k < 0 || gains[k] > gains[best_k]))
+      best_k = k;
+  if (best_k < 0) return std::nullopt;
+  const double best = gains[best_k];
+  Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+  for (int k = 0; k < kDirs; ++k)
+    if (gains[k] >= 0.8 * best && dir_of(k).dot(dir_of(best_k)) >= std::cos(70 * M_PI / 180))
+      sum += gains[k] * dir_of(k);
+  if (sum.norm() < 1e-9) return std::nullopt;
+  FlightAxis a;
+  a.dir = sum.normalized();
+  a.origin = foot.head<2>();
+  // Centre the axis between the flight's side walls, measured 0.6 m up the flight at the
+  // level of the support there.
+  const RobotModel& r = view.robot();
+  const Eigen::Vector2d nrm(-a.dir.y(), a.dir.x());
+  const Eigen::Vector2d probe = foot.head<2>() + 0.6 * a.dir;
+  const auto sp = view.support_surface_near(
+      Eigen::Vector3f(float(probe.x()), float(probe.y()), float(foot.z() + sign * 0.35)), 0.3);
+  const double h = sp ? double(sp->height_m) : foot.z() + sign * 0.35;
+  const double s = view.voxel_size_m();
+  auto side = [&](double sgn) {
+    for (double t = 0.5 * s; t <= 1.0; t += 0.5 * s) {
+      const Eigen::Vector2d q = probe + sgn * t * nrm;
+      if (obstacle_at(view, int32_t(std::floor(q.x() / s)), int32_t(std::floor(q.y() / s)), h))
+        return t;
+    }
+    return double(INFINITY);
+  };
+  const double left = side(1), right = side(-1);
+  const double half_w = 0.5 * r.body_width_m + r.body_margin_m;
+  double shift = 0;
+  if (std::isfinite(left) && std::isfinite(right))
+    shift = 0.5 * (left - right);
+  else if (std::isfinite(left) && left < half_w + 0.1)
+    shift = -(half_w + 0.1 - left);
+  else if (std::isfinite(right) && right < half_w + 0.1)
+    shift = half_w + 0.1 - right;
+  a.origin += std::clamp(shift, -0.4, 0.4) * nrm;
+  a.width_m = left + right;
+  return a;
+}
+
+FlightShaping shape_flights(const map::MapView& view, std::vector<Eigen::Vector3d>& points) {
+  FlightShaping out;
   const RobotModel& r = view.robot();
   const double s = view.voxel_size_m();
   const double run_up = 0.5 * r.body_length_m + r.body_margin_m;
   const double half_w = 0.5 * r.body_width_m + r.body_margin_m;
-  int inserted = 0;
+  const double level = 0.5 * r.step_height_m;
   for (size_t j = 1; j + 1 < points.size(); ++j) {
-    if (std::abs(points[j + 1].z() - points[j].z()) <= 0.5 * r.step_height_m) continue;
-    // Level change between j and j + 1: the flight's direction from j over the next metre.
-    size_t k = j + 1;
-    while (k + 1 < points.size() && (points[k] - points[j]).head<2>().norm() < climb_look_m) ++k;
-    Eigen::Vector2d dir = (points[k] - points[j]).head<2>();
-    if (dir.norm() < 0.5 * climb_look_m) continue;
-    dir.normalize();
-    const Eigen::Vector2d q2 = points[j].head<2>() - run_up * dir;
-    const auto sp = view.support_surface_near(
-        Eigen::Vector3f(float(q2.x()), float(q2.y()), float(points[j].z())), 0.5 * r.step_height_m);
-    if (!sp || !(sp->reachable || sp->state == map::TravState::kTraversable)) continue;
-    bool clear = true;
-    const int rv = int(std::ceil(half_w / s));
-    const int32_t cx = int32_t(std::floor(q2.x() / s)), cy = int32_t(std::floor(q2.y() / s));
-    for (int dx = -rv; dx <= rv && clear; ++dx)
-      for (int dy = -rv; dy <= rv && clear; ++dy)
-        if ((dx * dx + dy * dy) * s * s <= half_w * half_w)
-          clear = !obstacle_at(view, cx + dx, cy + dy, sp->height_m);
-    if (!clear) continue;
-    // Drop the points of the approach that lie within the run-up (they would turn the body
-    // there), keep the start, put the run-up point in their place.
+    if (std::abs(points[j + 1].z() - points[j].z()) <= level) continue;
+    const double sign = points[j + 1].z() > points[j].z() ? 1.0 : -1.0;
+    // The flight's extent in the path: it ends where the path stays level for a run-up.
+    size_t e = j + 1, level_from = j + 1;
+    while (e + 1 < points.size()) {
+      if (std::abs(points[e + 1].z() - points[e].z()) > level)
+        level_from = e + 1;
+      else if ((points[e + 1] - points[level_from]).head<2>().norm() >= run_up)
+        break;
+      ++e;
+    }
+    const bool ends_on_flight = e + 1 == points.size() && level_from + 1 >= e;
+    const size_t end = std::min(level_from, points.size() - 1);
+    Eigen::Vector2d hint = (points[end] - points[j]).head<2>();
+    if (hint.norm() < 0.2) {
+      j = e;
+      continue;
+    }
+    const auto axis = flight_axis(view, points[j], hint.normalized(), sign);
+    if (!axis) {
+      ++out.no_axis;
+      j = e;
+      continue;
+    }
+    // Foot of the flight on the axis; the run-up behind it on the lower level.
+    auto on_axis = [&](const Eigen::Vector2d& q) {
+      return axis->origin + axis->dir * (q - axis->origin).dot(axis->dir);
+    };
+    const Eigen::Vector2d foot2 = on_axis(points[j].head<2>());
+    const Eigen::Vector2d ru2 = foot2 - run_up * axis->dir;
+    const auto ru_sp = view.support_surface_near(
+        Eigen::Vector3f(float(ru2.x()), float(ru2.y()), float(points[j].z())), level);
+    if (!ru_sp || !(ru_sp->reachable || ru_sp->state == map::TravState::kTraversable) ||
+        !clear_disc(view, ru2, ru_sp->height_m, half_w)) {
+      ++out.no_run_up;
+      j = e;
+      continue;
+    }
+    // The flight's points along the axis, from the foot to the projection of its last point.
+    const double s_end = (points[end].head<2>() - foot2).dot(axis->dir);
+    std::vector<Eigen::Vector3d> line;
+    line.emplace_back(ru2.x(), ru2.y(), ru_sp->height_m);
+    const int n = std::max(1, int(std::ceil(s_end / s)));
+    double z_prev = points[j].z();
+    for (int i = 0; i <= n; ++i) {
+      const double t = std::min(s_end, i * s);
+      const Eigen::Vector2d q = foot2 + t * axis->dir;
+      const double expect =
+          points[j].z() + (points[end].z() - points[j].z()) * (t / std::max(s_end, 1e-6));
+      const auto sp = view.support_surface_near(
+          Eigen::Vector3f(float(q.x()), float(q.y()), float(expect)), r.step_height_m);
+      const double z = sp && std::abs(double(sp->height_m) - z_prev) <= r.step_height_m + 0.03
+                           ? double(sp->height_m)
+                           : expect;
+      line.emplace_back(q.x(), q.y(), z);
+      z_prev = z;
+    }
+    // Replace the approach within a run-up of the foot, the flight, and its last point.
     size_t first = j;
     while (first > 1 && (points[first - 1] - points[j]).head<2>().norm() < run_up) --first;
-    points.erase(points.begin() + long(first), points.begin() + long(j));
-    points.insert(points.begin() + long(first), Eigen::Vector3d(q2.x(), q2.y(), sp->height_m));
-    ++inserted;
-    // Skip the rest of the flight: it ends where the path stays level for a run-up's length.
-    j = first + 1;
-    size_t level_from = j;
-    while (j + 1 < points.size()) {
-      if (std::abs(points[j + 1].z() - points[j].z()) > 0.5 * r.step_height_m)
-        level_from = j + 1;
-      else if ((points[j + 1] - points[level_from]).head<2>().norm() >= run_up)
-        break;
-      ++j;
+    points.erase(points.begin() + long(first), points.begin() + long(end) + 1);
+    points.insert(points.begin() + long(first), line.begin(), line.end());
+    ++out.flights;
+    if (ends_on_flight && first + line.size() == points.size()) {
+      out.end_on_flight = true;
+      out.end_yaw_rad = std::atan2(axis->dir.y(), axis->dir.x());
     }
+    j = first + line.size() - 1;
   }
-  return inserted;
+  return out;
+}
+
+double shape_path(const map::MapView& view, std::vector<Eigen::Vector3d>& points, double goal_yaw) {
+  const FlightShaping f = shape_flights(view, points);
+  centre_path(view, points);
+  return f.end_on_flight ? f.end_yaw_rad : goal_yaw;
 }
 
 }  // namespace storey::core::plan

@@ -63,31 +63,44 @@ TEST(PathCentring, MovesPointsInADoorToItsMiddle) {
     }
 }
 
-TEST(PathCentring, RunUpBeforeAFlightIsOnItsAxis) {
+TEST(PathCentring, FlightIsWalkedOnItsAxisAfterARunUp) {
   map::TraversabilityMap m;
-  storey::test::scan_world(m, stair_world(), {{-1.5f, 0, 0.5f}, {-1.0f, 1.5f, 0.5f}});
+  storey::test::scan_world(m, stair_world(),
+                           {{-1.5f, 0, 0.5f}, {-1.0f, 1.5f, 0.5f}, {0.75f, 0, 0.95f}});
   const map::MapView view = m.view();
-  // Approaching the foot of the flight diagonally from the north-west, then up the first treads.
+  // The flight's axis from its foot, hinted diagonally: +x, on the flight's centre line.
+  const auto axis = flight_axis(view, {-0.1, 0.3, 0}, Eigen::Vector2d(1, -1).normalized(), 1.0);
+  ASSERT_TRUE(axis.has_value());
+  EXPECT_GT(axis->dir.x(), std::cos(10 * M_PI / 180)) << axis->dir.transpose();
+  EXPECT_NEAR(axis->origin.y() + (0.0 - axis->origin.x()) * axis->dir.y() / axis->dir.x(), 0.0,
+              0.12);
+  EXPECT_NEAR(axis->width_m, 1.2, 0.25);
+  // A path approaching the foot diagonally from the north-west and climbing near the north
+  // side wall, ending on the flight.
   std::vector<Vector3d> path = {{-1.2, 1.6, 0},   {-0.8, 1.2, 0},   {-0.4, 0.8, 0},
-                                {-0.2, 0.5, 0},   {-0.1, 0.2, 0},   {0.1, 0.1, 0.15},
-                                {0.4, 0.05, 0.3}, {0.7, 0.0, 0.45}, {1.0, 0.0, 0.6}};
-  ASSERT_EQ(align_before_climbs(view, path), 1);
-  // The foot of the flight stays; right before it, one point a run-up (0.4 m: half the body
-  // length + margin) back along the flight's direction, and no approach point in between.
+                                {-0.2, 0.5, 0},   {-0.1, 0.4, 0},   {0.1, 0.4, 0.15},
+                                {0.4, 0.35, 0.3}, {0.7, 0.3, 0.45}, {1.0, 0.3, 0.6}};
+  const FlightShaping f = shape_flights(view, path);
+  ASSERT_EQ(f.flights, 1) << f.no_axis << " " << f.no_run_up;
+  EXPECT_TRUE(f.end_on_flight);
+  EXPECT_NEAR(f.end_yaw_rad, 0.0, 0.2);
+  // The flight's points lie on the axis (within 0.15 m of the centre line y = 0) and rise
+  // monotonically; the run-up before the foot is level and on the same line.
   size_t foot = 0;
-  while (foot + 1 < path.size() && path[foot + 1].z() < 0.1) ++foot;
+  while (foot + 1 < path.size() && path[foot + 1].z() < 0.08) ++foot;
   ASSERT_GE(foot, 1u);
-  EXPECT_NEAR(path[foot].x(), -0.1, 1e-9);
-  const Vector3d& run_up = path[foot - 1];
-  const double run = (path[foot] - run_up).head<2>().norm();
+  for (size_t i = foot - 1; i < path.size(); ++i) {
+    EXPECT_LT(std::abs(path[i].y()), 0.15) << i << ": " << path[i].transpose();
+    if (i > foot) EXPECT_GE(path[i].z(), path[i - 1].z() - 0.03) << i;
+  }
+  EXPECT_LT(std::abs(path[foot - 1].z()), 0.05);
   const RobotModel robot;
-  EXPECT_NEAR(run, 0.5 * robot.body_length_m + robot.body_margin_m, 1e-6);
-  // The flight rises along +x (slightly south in this path): the run-up lies west of the foot.
-  EXPECT_LT(run_up.x(), path[foot].x() - 0.35);
-  EXPECT_LT(std::abs(run_up.z()), 0.05);
+  EXPECT_NEAR((path[foot] - path[foot - 1]).head<2>().norm(),
+              0.5 * robot.body_length_m + robot.body_margin_m, 0.11);
+  EXPECT_NEAR(path.back().x(), 1.0, 0.12);
   // A path that stays level is left alone.
   std::vector<Vector3d> level = {{-2, 0, 0}, {-1.5, 0, 0}, {-1, 0, 0}};
-  EXPECT_EQ(align_before_climbs(view, level), 0);
+  EXPECT_EQ(shape_flights(view, level).flights, 0);
   EXPECT_EQ(level.size(), 3u);
 }
 
@@ -110,4 +123,35 @@ TEST(PathCentring, BodyAtRestOnAFlightTakesTheTerrainPitch) {
                               {0.3f * (i + 1), 0.6f, 0.15f * (i + 1)});
   EXPECT_TRUE(cc.check_poses(std::span<const BodyPose>(&rest, 1), vox).collides)
       << "scenario: a level box on the flight should touch the treads ahead";
+}
+
+TEST(PathCentring, FootOfAFlightIsReachableOnASparseMap) {
+  // 0.167 m risers (a 3 m storey in 18), 0.29 m treads, seen by a VLP-16 at 0.44 m while
+  // walking toward the flight: the floor right behind the robot is in the LiDAR's blind ring,
+  // tread tops are sparse and nosing voxels mix tread and riser points.
+  storey::test::World w;
+  w.add(aabb({-4, -3, -0.2f}, {8, 3, 0}));
+  w.stairs(0.0f, -0.6f, 0.6f, 0.0f, 17, 3.0f / 18, 0.29f);
+  w.add(aabb({0, -0.72f, 0}, {5, -0.6f, 2.5f}));
+  w.add(aabb({0, 0.6f, 0}, {5, 0.72f, 2.5f}));
+  map::TraversabilityMap m;
+  uint32_t seed = 1;
+  for (float x : {-2.0f, -1.0f, -0.5f})
+    for (int r = 0; r < 10; ++r) {
+      const Eigen::Vector3f o(x, 0.05f * r - 0.2f, 0.44f);
+      m.insert_scan(o, storey::test::scan_vlp16(w, o, 0.1f * r, seed++));
+    }
+  m.update_traversability();
+  const map::MapView view = m.view();
+  CollisionChecker cc(RobotModel{}, view.voxel_size_m());
+  // Standing level on the floor up to the first riser, facing the flight: the front legs on
+  // the first tread tilt the body; nothing collides.
+  for (double x = -0.8; x <= 0.0 + 1e-9; x += 0.1) {
+    const BodyPose p{{x, 0.0, 0.0}, 0.0, 0.0, 0.0};
+    const CollisionHit h = cc.check_poses(view, std::span<const BodyPose>(&p, 1));
+    EXPECT_FALSE(h.collides) << "x " << x << " voxel " << h.voxel_m.transpose();
+  }
+  // The same body 0.5 m into the flight at floor height is inside the treads: still caught.
+  const BodyPose inside{{0.5, 0.0, 0.0}, 0.0, 0.0, 0.0};
+  EXPECT_TRUE(cc.check_poses(view, std::span<const BodyPose>(&inside, 1)).collides);
 }
