@@ -320,8 +320,10 @@ void Autonomy::plan_step() {
       // complete_after_s, or the exhausted state must have lasted complete_unsettled_after_s
       // (the graph's bounded per-cycle work can churn on sensor noise without ever yielding a
       // reachable target).
+      // (A baseline keeps its own frontiers and set-aside list: its kComplete is exhaustion.)
       count_exhausted(w, s);
-      const bool exhausted = s.clusters_set_aside + s.clusters_unreachable >= w.clusters.size();
+      const bool exhausted = !policy_->local_layer() ||
+                             s.clusters_set_aside + s.clusters_unreachable >= w.clusters.size();
       if (!exhausted) idle_since_s_ = now;
       const double idle_s = now - idle_since_s_;
       const bool was_complete = complete_;

@@ -2,6 +2,10 @@
 
 #include <stdexcept>
 
+#include "core/baselines/fael_like_planner.hpp"
+#include "core/baselines/nearest_frontier_planner.hpp"
+#include "core/baselines/tare_like_planner.hpp"
+
 namespace storey::firmware {
 
 namespace {
@@ -25,6 +29,23 @@ class StoreyPolicy final : public ExplorationPolicy {
   core::plan::ExplorationPlanner planner_;
 };
 
+// A baseline of core/baselines/ (same input, same result shape).
+template <class Planner>
+class BaselinePolicy final : public ExplorationPolicy {
+ public:
+  BaselinePolicy(const char* name, const config::Parameters& p)
+      : name_(name), planner_(p.robot, p.plan, p.map.voxel_size_m) {}
+  const char* name() const override { return name_; }
+  core::plan::ExplorationResult plan(const core::plan::ExplorationInput& in) override {
+    return planner_.plan(in);
+  }
+  void drop_target() override { planner_.drop_target(); }
+
+ private:
+  const char* name_;
+  Planner planner_;
+};
+
 }  // namespace
 
 const std::vector<std::string>& exploration_methods() {
@@ -35,7 +56,14 @@ const std::vector<std::string>& exploration_methods() {
 
 std::unique_ptr<ExplorationPolicy> make_exploration_policy(const std::string& method,
                                                            const config::Parameters& params) {
+  namespace b = core::baselines;
   if (method == "storey") return std::make_unique<StoreyPolicy>(params);
+  if (method == "nearest-frontier")
+    return std::make_unique<BaselinePolicy<b::NearestFrontierPlanner>>("nearest-frontier", params);
+  if (method == "fael-like")
+    return std::make_unique<BaselinePolicy<b::FaelLikePlanner>>("fael-like", params);
+  if (method == "tare-like")
+    return std::make_unique<BaselinePolicy<b::TareLikePlanner>>("tare-like", params);
   throw std::invalid_argument("exploration method '" + method +
                               "': unknown (known: storey, nearest-frontier, fael-like, tare-like)");
 }

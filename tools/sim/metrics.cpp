@@ -74,7 +74,20 @@ std::string metrics_json(const RunMetrics& m) {
     std::snprintf(b, sizeof b, fmt, args...);
     s += b;
   };
-  add("{\n  \"success\": %s,\n  \"floors_total\": %d,\n  \"floors_explored\": %d,\n",
+  auto str = [](const std::string& v) {  // JSON string body: quotes, backslashes, controls
+    std::string o;
+    for (char c : v) {
+      if (c == '"' || c == '\\')
+        o += '\\', o += c;
+      else if (static_cast<unsigned char>(c) >= 0x20)
+        o += c;
+    }
+    return o;
+  };
+  s += "{\n  \"method\": \"" + str(m.method) + "\",\n  \"ablation\": \"" + str(m.ablation) +
+       "\",\n  \"completed\": " + (m.completed ? "true" : "false") + ",\n  \"end_reason\": \"" +
+       str(m.end_reason) + "\",\n";
+  add("  \"success\": %s,\n  \"floors_total\": %d,\n  \"floors_explored\": %d,\n",
       m.success ? "true" : "false", m.floors_total, m.floors_explored);
   add("  \"exploration_time_s\": %.3f,\n  \"trajectory_length_m\": %.3f,\n", m.exploration_time_s,
       m.trajectory_length_m);

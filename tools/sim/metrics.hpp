@@ -52,6 +52,11 @@ struct LatencyMetrics {
 // DESIGN §7 metrics.json. The simulator fills the truth-derived fields; the firmware the rest.
 struct RunMetrics {
   bool success = false;
+  // What ran and how it ended (storey-eval reads end_reason): the exploration method
+  // (exploration_policy.hpp), the ablation ("" = none), whether the planner reported exploration
+  // complete, and the one-line reason the run ended.
+  std::string method = "storey", ablation, end_reason;
+  bool completed = false;
   int floors_total = 0, floors_explored = 0;
   double exploration_time_s = 0.0, trajectory_length_m = 0.0;
   double traversable_volume_m3 = 0.0, occupied_volume_m3 = 0.0;        // observed

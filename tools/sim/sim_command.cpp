@@ -18,7 +18,7 @@ void usage(FILE* out) {
   std::fprintf(
       out,
       "usage: storey sim [--scene NAME|FILE] [--start X,Y,Z,YAW_DEG] [--sensor vlp16|mid360]\n"
-      "                  [--seed N] [--method storey] [--ablation NAME] [--time-limit S]\n"
+      "                  [--seed N] [--method M] [--ablation NAME] [--time-limit S]\n"
       "                  [--out DIR] [--config FILE]\n\n"
       "Lockstep simulated exploration (deterministic for a seed). Progress every 5 simulated\n"
       "seconds on stderr; ends when the planner reports exploration complete or at the\n"
@@ -29,10 +29,11 @@ void usage(FILE* out) {
       "  --start X,Y,Z,YAW  start pose: ground point [m] and heading [deg] (default: scene's)\n"
       "  --sensor S         vlp16 (default) or mid360\n"
       "  --seed N           seed of the sensor noise and graph sampling (default 1)\n"
-      "  --method M         storey (baselines nearest-frontier, fael-like, tare-like: not\n"
-      "                     available yet)\n"
-      "  --ablation NAME    no-tentative, no-c-sur, no-c-exp, boundary-frontiers (no-prior,\n"
-      "                     no-incremental: not available yet)\n"
+      "  --method M         storey (default: the paper's method), or a baseline over the same\n"
+      "                     map, graph, speed limits and trajectories: nearest-frontier,\n"
+      "                     fael-like (one floor's 2D grid), tare-like (height-bounded links)\n"
+      "  --ablation NAME    storey only: no-tentative, no-c-sur, no-c-exp, boundary-frontiers,\n"
+      "                     no-prior, no-incremental\n"
       "  --time-limit S     simulated seconds before giving up (default 1200)\n"
       "  --out DIR          run record folder (default out/<scene>)\n"
       "  --config FILE      configuration (default config/default.yaml)\n");
@@ -111,8 +112,10 @@ int cmd_sim(int argc, char** argv) {
     o.out_dir = "out/" + name;
   }
   try {
-    std::fprintf(stderr, "storey sim: scene %s, sensor %s, seed %llu, time limit %.0f s\n",
-                 o.scene.c_str(), o.sensor.c_str(), (unsigned long long)o.seed, o.time_limit_s);
+    std::fprintf(stderr,
+                 "storey sim: scene %s, method %s%s%s, sensor %s, seed %llu, time limit %.0f s\n",
+                 o.scene.c_str(), o.method.c_str(), o.ablation.empty() ? "" : ", ablation ",
+                 o.ablation.c_str(), o.sensor.c_str(), (unsigned long long)o.seed, o.time_limit_s);
     const tools::sim::SimRunResult r = tools::sim::run_exploration(o);
     const auto& m = r.metrics;
     std::fprintf(stderr,

@@ -64,9 +64,10 @@ void apply_ablation(const std::string& name, config::Parameters& p) {
     p.graph.use_c_exp = false;
   else if (name == "boundary-frontiers")
     p.graph.boundary_frontiers = true;
-  else if (name == "no-prior" || name == "no-incremental")
-    throw std::invalid_argument(
-        "--ablation " + name + ": not available yet (needs the macro layer: task zones and prior)");
+  else if (name == "no-prior")
+    p.plan.use_prior = false;  // paper Table IV: no cross-floor prior
+  else if (name == "no-incremental")
+    p.plan.incremental_maintenance = false;  // prior without split / reassignment (IV-B)
   else
     throw std::invalid_argument("--ablation " + name +
                                 ": unknown (known: no-tentative, no-c-sur, "
@@ -205,9 +206,10 @@ void write_record(const RecordInputs& in, std::vector<std::string>& written) {
   // report.md ties it together.
   std::ofstream r(dir + "/report.md");
   r << "# storey sim: " << in.scene->name << "\n\n";
-  r << "Command: `storey sim --scene " << in.opt->scene << " --sensor " << in.opt->sensor
-    << " --seed " << in.opt->seed << " --time-limit " << in.opt->time_limit_s
-    << (in.opt->ablation.empty() ? "" : " --ablation " + in.opt->ablation) << "`\n\n";
+  r << "Command: `storey sim --scene " << in.opt->scene << " --method " << in.opt->method
+    << " --sensor " << in.opt->sensor << " --seed " << in.opt->seed << " --time-limit "
+    << in.opt->time_limit_s << (in.opt->ablation.empty() ? "" : " --ablation " + in.opt->ablation)
+    << "`\n\n";
   r << "Outcome: **" << (m.success ? "success" : "no success") << "** - " << in.result->end_reason
     << "\n\n";
   if (!in.error.empty()) r << "Run failed: `" << in.error << "`\n\n";
@@ -256,9 +258,10 @@ SimRunResult run_exploration(const SimRunOptions& opt) {
     throw std::invalid_argument(
         "--method " + opt.method +
         ": unknown (known: storey, nearest-frontier, fael-like, tare-like)");
-  if (opt.method != "storey")
-    throw std::invalid_argument("--method " + opt.method +
-                                ": not available yet (baselines arrive with storey-eval)");
+  if (opt.method != "storey" && !opt.ablation.empty())
+    throw std::invalid_argument(
+        "--ablation " + opt.ablation +
+        ": ablations switch parts of the storey method; not with --method " + opt.method);
   if (opt.sensor != "vlp16" && opt.sensor != "mid360")
     throw std::invalid_argument("--sensor " + opt.sensor + ": expected vlp16 or mid360");
   if (!(opt.time_limit_s > 0)) throw std::invalid_argument("--time-limit must be > 0");
@@ -292,6 +295,7 @@ SimRunResult run_exploration(const SimRunOptions& opt) {
   firmware::AutonomyOptions ao;
   ao.params = params;
   ao.seed = opt.seed;
+  ao.method = opt.method;
   ao.fov =
       opt.sensor == "mid360" ? core::graph::SensorFov::mid360() : core::graph::SensorFov::vlp16();
   ao.stop_on_overruns = false;  // lockstep: see AutonomyOptions
@@ -335,23 +339,24 @@ SimRunResult run_exploration(const SimRunOptions& opt) {
       if (progress_ns > 0 && (t_ns >= next_progress || done)) {
         next_progress += progress_ns;
         const Coverage c = sample_coverage(t);
-        char line[256];
+        char line[384];
         std::snprintf(
             line, sizeof line,
             "[sim %7.1f s] coverage %5.1f %%  floor %d  nodes %u  frontiers %u (clusters %u)"
-            "  stops %llu  plan %s",
+            "  stops %llu  plan %s (%s)",
             t, 100 * c.traversable_coverage, st.floor_hint, st.nodes, st.frontier_nodes,
             st.clusters, (unsigned long long)autonomy.safety_stops(),
-            core::plan::to_string(st.last_plan));
+            core::plan::to_string(st.last_plan), st.plan_reason);
         progress(line);
       }
       if (done) {
         res.completed = true;
-        char why[200];
+        char why[320];
         std::snprintf(why, sizeof why,
-                      "exploration complete at %.1f s: no reachable frontier left (%u clusters, "
-                      "%u set aside as unobservable, %u unreachable)",
-                      t, st.clusters, st.clusters_set_aside, st.clusters_unreachable);
+                      "exploration complete at %.1f s: %s (%u clusters, %u set aside as "
+                      "unobservable, %u unreachable)",
+                      t, st.plan_reason, st.clusters, st.clusters_set_aside,
+                      st.clusters_unreachable);
         res.end_reason = why;
         break;
       }
@@ -386,6 +391,10 @@ SimRunResult run_exploration(const SimRunOptions& opt) {
     l.overruns = tr.overruns;
     m.latency.push_back(l);
   }
+  m.method = opt.method;
+  m.ablation = opt.ablation;
+  m.completed = res.completed;
+  m.end_reason = res.end_reason;
   m.success = res.completed && error.empty() && m.floors_explored == m.floors_total &&
               m.collisions == 0 && m.falls == 0;
 

@@ -36,8 +36,8 @@ struct SimRunResult {
   std::vector<std::string> log;  // the firmware's log lines (safety stops ...)
 };
 
-// Names of the method and ablation switches; unknown or not-yet-available ones are refused by
-// run_exploration with std::invalid_argument (one line: "--method fael-like: not available yet").
+// Names of the method and ablation switches; unknown ones (and an ablation with a baseline
+// method) are refused by run_exploration with std::invalid_argument (one line naming the flag).
 const std::vector<std::string>& known_methods();
 const std::vector<std::string>& known_ablations();
 

@@ -1,0 +1,158 @@
+#include "core/baselines/goal_driver.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/plan/path_centring.hpp"
+#include "core/plan/plan_config.hpp"
+
+namespace storey::core::baselines {
+
+namespace {
+double dist_xy(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return (a - b).head<2>().norm();
+}
+bool near(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double r) {
+  return dist_xy(a, b) <= r && std::abs(a.z() - b.z()) < 0.5;
+}
+}  // namespace
+
+GoalDriver::GoalDriver(const RobotModel& robot, const plan::PlanOptions& plan, double voxel_size_m,
+                       const BaselineOptions& options)
+    : robot_(robot),
+      opt_(options),
+      astar_(plan::astar_options(plan)),
+      builder_(robot, plan::trajectory_options(plan)),
+      checker_(robot, voxel_size_m) {}
+
+bool GoalDriver::set_aside(const Eigen::Vector3d& key_m) const {
+  for (const Eigen::Vector3d& s : set_aside_)
+    if (near(s, key_m, opt_.set_aside_radius_m)) return true;
+  return false;
+}
+
+bool GoalDriver::set_aside(const Goal& g) const {
+  // Frontier clusters change shape as the map grows (their centroid moves): a goal is also set
+  // aside when the place to stand is one where the robot already stood or failed.
+  return set_aside(g.key_m) || set_aside(g.p_m);
+}
+
+bool GoalDriver::keep(const plan::ExplorationInput& in, const std::vector<Goal>& goals,
+                      plan::ExplorationResult& r) {
+  if (!has_target_) return false;
+  bool still_goal = false;
+  for (const Goal& g : goals) still_goal = still_goal || near(g.key_m, target_.key_m, 0.5);
+  const bool reached = dist_xy(in.robot_foot_m, target_.p_m) <= opt_.reached_radius_m &&
+                       std::abs(in.robot_foot_m.z() - target_.p_m.z()) < 0.5;
+  if (reached) {
+    // Stood there and the frontier is still one: nothing more to see from reachable ground.
+    if (still_goal) add_set_aside(target_.key_m), add_set_aside(target_.p_m);
+    has_target_ = false;
+    return false;
+  }
+  if (!still_goal) {
+    has_target_ = false;
+    return false;
+  }
+  if (in.t_s > traj_end_s_ + opt_.overdue_s) {  // never arrived: blocked on the way
+    add_set_aside(target_.key_m);
+    has_target_ = false;
+    return false;
+  }
+  if (in.t_s - planned_at_s_ >= opt_.replan_period_s) {
+    has_target_ = false;
+    return false;
+  }
+  r.status = plan::ExplorationStatus::kKeep;
+  r.reason = "keep target";
+  r.target_m = target_.p_m;
+  r.target_yaw_rad = target_.yaw_rad;
+  return true;
+}
+
+bool GoalDriver::drive(const plan::ExplorationInput& in, const Goal& g,
+                       plan::ExplorationResult& r) {
+  // The body box with its margin may overlap an obstacle where the robot stands (tracking error,
+  // a jamb seen late): every trajectory from there collides at its first pose. As the local
+  // layer does, start from the nearest collision-free pose within 0.3 m instead (the control task
+  // tracks from the point of a new trajectory nearest the robot).
+  Eigen::Vector3d start = in.robot_foot_m;
+  plan::BodyPose here{start, in.robot_yaw_rad, 0.0, in.t_s};
+  if (checker_.check_poses(*in.view, std::span<const plan::BodyPose>(&here, 1)).collides) {
+    bool found = false;
+    for (double d = 0.05; d <= 0.3 + 1e-9 && !found; d += 0.05)
+      for (int k = 0; k < 16 && !found; ++k) {
+        const double a = k * M_PI / 8;
+        plan::BodyPose p = here;
+        p.foot_m = in.robot_foot_m + d * Eigen::Vector3d(std::cos(a), std::sin(a), 0);
+        if (!checker_.check_poses(*in.view, std::span<const plan::BodyPose>(&p, 1)).collides)
+          start = p.foot_m, found = true;
+      }
+    if (!found) return false;
+  }
+  std::vector<Eigen::Vector3d> path = g.path_m;
+  if (path.empty() || start != in.robot_foot_m) {
+    plan::VoxelPath vp = astar_.plan(*in.view, start, g.p_m);
+    if (vp.status != plan::VoxelAStarStatus::kOk || vp.points_m.empty()) return false;
+    path = std::move(vp.points_m);
+  }
+  path.front() = start;
+  if (filter_ && !filter_(path)) return false;
+  plan::centre_path(*in.view, path);
+  plan::align_before_climbs(*in.view, path);
+  plan::TrajectoryResult tr =
+      builder_.build(*in.view, checker_, path, in.robot_yaw_rad, g.yaw_rad, in.t_s);
+  if (tr.status != plan::TrajectoryStatus::kOk && tr.status != plan::TrajectoryStatus::kPolyline)
+    return false;
+  r.status = plan::ExplorationStatus::kNewTrajectory;
+  r.trajectory = std::move(tr.trajectory);
+  r.real_until_s = r.trajectory.t_end();  // baselines have no hypothetical space
+  r.target_m = g.p_m;
+  r.target_yaw_rad = g.yaw_rad;
+  return true;
+}
+
+void GoalDriver::choose(const plan::ExplorationInput& in, std::vector<Goal>& goals,
+                        plan::ExplorationResult& r) {
+  std::erase_if(goals, [&](const Goal& g) { return set_aside(g); });
+  if (goals.empty()) {
+    // Nothing to see yet because the reachable set has not reached the robot (start-up): the
+    // map is still growing, not exhausted.
+    const auto s = in.view->support_surface_near(in.robot_foot_m.cast<float>(), 0.3);
+    if (!s || !s->reachable) {
+      r.status = plan::ExplorationStatus::kExploring;
+      r.reason = "no reachable support at the robot yet";
+      return;
+    }
+    r.status = plan::ExplorationStatus::kComplete;
+    r.reason = "no reachable, observable frontier left";
+    return;
+  }
+  std::stable_sort(goals.begin(), goals.end(),
+                   [](const Goal& a, const Goal& b) { return a.cost < b.cost; });
+  int attempts = 0;
+  for (const Goal& g : goals) {
+    if (attempts++ >= opt_.max_attempts) break;
+    if (drive(in, g, r)) {
+      has_target_ = true;
+      target_ = g;
+      planned_at_s_ = in.t_s;
+      traj_end_s_ = r.trajectory.t_end();
+      r.reason = "new frontier target";
+      return;
+    }
+    auto it = std::find_if(failures_.begin(), failures_.end(),
+                           [&](const auto& f) { return near(f.first, g.key_m, 0.3); });
+    if (it == failures_.end()) it = failures_.insert(failures_.end(), {g.key_m, 0});
+    if (++it->second >= opt_.max_failures) {
+      add_set_aside(g.key_m);
+      add_set_aside(g.p_m);
+      failures_.erase(it);
+    }
+  }
+  has_target_ = false;
+  r.status = plan::ExplorationStatus::kExploring;
+  r.reason = "no feasible trajectory to a frontier this cycle";
+}
+
+}  // namespace storey::core::baselines

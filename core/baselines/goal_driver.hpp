@@ -1,0 +1,98 @@
+#pragma once
+// What every baseline shares with the paper's method and with each other (issue 10: "same map,
+// speed limits, sensor and statistics"): the Stage-3 machinery of core/plan used as a library
+// (voxel A* or a given support polyline -> path centring -> collision-checked, speed-limited
+// B-spline), plus the target bookkeeping every frontier planner needs: keep a target until it
+// is reached, gone or due for a replan; set aside goals that stay frontiers after the robot
+// stood there or whose Stage 3 fails repeatedly (so exploration ends when nothing reachable
+// and observable is left). Single-threaded; owned by one baseline planner.
+#include <functional>
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/plan/bspline_trajectory.hpp"
+#include "core/plan/collision_checker.hpp"
+#include "core/plan/exploration_planner.hpp"
+#include "core/plan/plan_options.hpp"
+#include "core/plan/voxel_astar.hpp"
+#include "core/robot_model.hpp"
+
+namespace storey::core::baselines {
+
+struct BaselineOptions {
+  double replan_period_s = 4.0;       // re-choose a kept target this often [s]
+  double reached_radius_m = 0.5;      // robot this close (horizontally) to the goal = reached
+  double set_aside_radius_m = 0.5;    // goals this close to a set-aside one are ignored [m]
+  int max_failures = 2;               // Stage 3 failures before a goal is set aside
+  int max_attempts = 6;               // Stage 3 attempts per cycle (bounded work)
+  double overdue_s = 10.0;            // trajectory ended this long ago without arrival: set aside
+  int min_cluster_cells = 4;          // smaller frontier clusters are noise (nearest-frontier,
+                                      // fael-like)
+  double height_threshold_m = 0.3;    // tare-like: largest height difference of a link [m] ...
+  double link_spacing_m = 1.0;        // ... per this much horizontal distance (viewpoint spacing)
+  double global_cell_m = 8.0;         // tare-like: horizontal size of a global subspace [m]
+  double fael_band_m = 0.15;          // fael-like: support within this of the floor height is free
+  double fael_obstacle_from_m = 0.1;  // fael-like: anything occupied above floor + this, below
+                                      // the body top, is an obstacle (steps, ramps past the band)
+};
+
+// A goal candidate of one baseline: where to stand, which way to face, and a key position for
+// the set-aside list (the frontier it serves).
+struct Goal {
+  Eigen::Vector3d p_m = Eigen::Vector3d::Zero();    // support point to drive to
+  double yaw_rad = 0;                               // facing the unknown
+  Eigen::Vector3d key_m = Eigen::Vector3d::Zero();  // the frontier's position (set-aside key)
+  double cost = 0;                                  // the method's ordering cost (lower first)
+  std::vector<Eigen::Vector3d> path_m;  // support polyline from the robot (empty: voxel A*)
+};
+
+class GoalDriver {
+ public:
+  GoalDriver(const RobotModel& robot, const plan::PlanOptions& plan, double voxel_size_m,
+             const BaselineOptions& options);
+
+  // Keep the current target? Call first each cycle with the goals of this cycle. Returns true
+  // (and fills r as kKeep) if the target is still a goal (a goal key within set_aside_radius_m),
+  // not reached, not overdue and younger than replan_period_s. Reaching a target whose frontier
+  // is still a goal sets it aside (not observable from where the robot can stand).
+  bool keep(const plan::ExplorationInput& in, const std::vector<Goal>& goals,
+            plan::ExplorationResult& r);
+  // Goals in cost order minus set-aside ones; tries Stage 3 on them (at most max_attempts) and
+  // fills r: kNewTrajectory, or kComplete when none is left, or kExploring when all attempts
+  // failed this cycle (failing goals are set aside after max_failures cycles).
+  void choose(const plan::ExplorationInput& in, std::vector<Goal>& goals,
+              plan::ExplorationResult& r);
+  // Stage 3 to one goal: voxel A* (or the goal's own polyline), centring, B-spline.
+  bool drive(const plan::ExplorationInput& in, const Goal& g, plan::ExplorationResult& r);
+
+  bool set_aside(const Eigen::Vector3d& key_m) const;
+  bool set_aside(const Goal& g) const;  // its key or its standing point
+  void drop_target() { has_target_ = false; }
+  bool has_target() const { return has_target_; }
+  size_t set_aside_count() const { return set_aside_.size(); }
+  plan::VoxelAStar& astar() { return astar_; }
+  // Optional path filter (tare-like: no climbs steeper than its link rule); false rejects.
+  void set_path_filter(std::function<bool(const std::vector<Eigen::Vector3d>&)> filter) {
+    filter_ = std::move(filter);
+  }
+
+ private:
+  void add_set_aside(const Eigen::Vector3d& key_m) { set_aside_.push_back(key_m); }
+
+  RobotModel robot_;
+  BaselineOptions opt_;
+  plan::VoxelAStar astar_;
+  plan::TrajectoryBuilder builder_;
+  plan::CollisionChecker checker_;
+  std::function<bool(const std::vector<Eigen::Vector3d>&)> filter_;
+  // Current target.
+  bool has_target_ = false;
+  Goal target_;
+  double planned_at_s_ = 0, traj_end_s_ = 0;
+  std::vector<Eigen::Vector3d> set_aside_;
+  std::vector<std::pair<Eigen::Vector3d, int>> failures_;
+};
+
+}  // namespace storey::core::baselines

@@ -1,0 +1,172 @@
+#include "core/baselines/tare_like_planner.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <tuple>
+
+namespace storey::core::baselines {
+
+bool tare_link_ok(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double threshold_m,
+                  double spacing_m) {
+  const double dz = std::abs(a.z() - b.z());
+  const double h = (a - b).head<2>().norm();
+  return dz <= threshold_m && dz <= threshold_m * std::max(h, 1e-3) / spacing_m + 1e-9;
+}
+
+bool tare_path_ok(const std::vector<Eigen::Vector3d>& path_m, double threshold_m,
+                  double spacing_m) {
+  // Windows of about spacing_m along the path (two-pointer walk).
+  size_t j = 0;
+  for (size_t i = 0; i < path_m.size(); ++i) {
+    if (j < i) j = i;
+    while (j + 1 < path_m.size() && (path_m[j] - path_m[i]).head<2>().norm() < spacing_m) ++j;
+    if (j > i && !tare_link_ok(path_m[i], path_m[j], threshold_m, spacing_m)) {
+      // A short window at the path's end: judge it by the rule's gradient only.
+      return false;
+    }
+  }
+  return true;
+}
+
+TareLikePlanner::TareLikePlanner(const RobotModel& robot, const plan::PlanOptions& plan,
+                                 double voxel_size_m, const BaselineOptions& options)
+    : opt_(options),
+      driver_(robot, plan, voxel_size_m, options),
+      tsp_(plan::TspOptions{plan.tsp_exact_max_n}) {
+  const double th = options.height_threshold_m, sp = options.link_spacing_m;
+  driver_.set_path_filter(
+      [th, sp](const std::vector<Eigen::Vector3d>& p) { return tare_path_ok(p, th, sp); });
+}
+
+std::vector<Goal> TareLikePlanner::goals(const plan::ExplorationInput& in) {
+  std::vector<Goal> out;
+  const graph::ReachableGraph& g = *in.graph;
+  // Viewpoint graph: G_real's nodes, its real edges that pass the height rule.
+  std::vector<Eigen::Vector3d> pos(g.node_capacity(), Eigen::Vector3d::Zero());
+  for (graph::NodeId i = 0; i < g.node_capacity(); ++i)
+    if (g.node(i).alive) pos[i] = g.node(i).p_m.cast<double>();
+  std::vector<plan::SearchGraph::Edge> edges;
+  kept_ = refused_ = 0;
+  for (graph::EdgeId e = 0; e < g.edge_capacity(); ++e) {
+    const graph::GraphEdge& ge = g.edge(e);
+    if (!ge.alive || ge.state == graph::ElementState::kHypothetical) continue;
+    if (!tare_link_ok(pos[ge.a], pos[ge.b], opt_.height_threshold_m, opt_.link_spacing_m)) {
+      ++refused_;
+      continue;
+    }
+    ++kept_;
+    edges.push_back({ge.a, ge.b, double(std::max(ge.cost, ge.length_m))});
+  }
+  sg_ = plan::SearchGraph::from_edges(pos, edges, true);
+  uint32_t robot = g.root();
+  if (robot == graph::kNoId || !g.node(robot).alive)
+    robot = g.nearest(in.robot_foot_m.cast<float>(), 1.5f, 1.0f);
+  if (robot == graph::kNoId) return out;
+  search_.dijkstra(sg_, std::span<const uint32_t>(&robot, 1));
+
+  // Reachable clusters: representative = reachable member nearest the centroid.
+  struct Cand {
+    size_t ci;
+    uint32_t rep;
+    double d;
+    std::tuple<int, int, int> cell;
+  };
+  std::vector<Cand> cands;
+  const double cell = opt_.global_cell_m;
+  for (size_t ci = 0; ci < in.clusters->size(); ++ci) {
+    const graph::FrontierCluster& c = (*in.clusters)[ci];
+    uint32_t rep = graph::kNoId;
+    float best = std::numeric_limits<float>::infinity();
+    for (graph::NodeId n : c.nodes) {
+      if (!std::isfinite(search_.dist(n)) || driver_.set_aside(pos[n])) continue;
+      const float d = (g.node(n).p_m - c.centroid_m).squaredNorm();
+      if (d < best) best = d, rep = n;
+    }
+    if (rep == graph::kNoId) continue;
+    const Eigen::Vector3d p = pos[rep];
+    cands.push_back({ci,
+                     rep,
+                     search_.dist(rep),
+                     {int(std::floor(p.x() / cell)), int(std::floor(p.y() / cell)),
+                      int(std::lround(p.z() / 3.0))}});
+  }
+  if (cands.empty()) return out;
+  // Global layer: subspaces with work, ordered by an open TSP from the robot.
+  std::map<std::tuple<int, int, int>, std::vector<size_t>> cells;
+  for (size_t i = 0; i < cands.size(); ++i) cells[cands[i].cell].push_back(i);
+  std::vector<uint32_t> reps{robot};
+  std::vector<std::vector<size_t>> members;
+  for (auto& [key, idx] : cells) {
+    // The subspace's representative: its member nearest the robot along the graph.
+    size_t b = idx.front();
+    for (size_t i : idx)
+      if (cands[i].d < cands[b].d) b = i;
+    reps.push_back(cands[b].rep);
+    members.push_back(idx);
+  }
+  const int n = int(reps.size());
+  std::vector<double> cost(size_t(n) * size_t(n), 0.0);
+  for (int i = 0; i < n; ++i)
+    search_.costs_from(sg_, reps[size_t(i)], reps,
+                       std::span<double>(cost.data() + size_t(i) * size_t(n), size_t(n)));
+  const plan::TspResult tour = tsp_.solve(plan::CostMatrix{n, cost}, 0);
+  std::vector<int> order;
+  if (tour.status == plan::TspStatus::kOk)
+    for (int k : tour.order)
+      if (k > 0) order.push_back(k - 1);
+  if (order.size() != members.size()) {
+    order.clear();
+    for (int k = 0; k < int(members.size()); ++k) order.push_back(k);
+  }
+  // Local layer: clusters of the first subspace by graph distance, then the following ones.
+  search_.dijkstra(sg_, std::span<const uint32_t>(&robot, 1));
+  double rank = 0;
+  for (int m : order) {
+    std::vector<size_t> idx = members[size_t(m)];
+    std::stable_sort(idx.begin(), idx.end(),
+                     [&](size_t a, size_t b) { return cands[a].d < cands[b].d; });
+    for (size_t i : idx) {
+      const Cand& c = cands[i];
+      const graph::FrontierCluster& fc = (*in.clusters)[c.ci];
+      Goal goal;
+      goal.key_m = pos[c.rep];
+      goal.p_m = pos[c.rep];
+      Eigen::Vector3d look = fc.centroid_m.cast<double>() - goal.p_m;
+      for (const graph::ClusterViewpoints& cv : *in.viewpoints) {
+        if (cv.cluster_id != fc.id) continue;
+        for (const graph::Viewpoint& v : cv.viewpoints)
+          if (v.node < g.node_capacity() && g.node(v.node).alive &&
+              std::isfinite(search_.dist(v.node))) {
+            goal.p_m = v.p_m.cast<double>();
+            look = Eigen::Vector3d(std::cos(v.yaw_rad), std::sin(v.yaw_rad), 0);
+            break;
+          }
+      }
+      goal.yaw_rad = look.head<2>().norm() > 1e-6 ? std::atan2(look.y(), look.x()) : 0.0;
+      goal.cost = rank++;
+      out.push_back(std::move(goal));
+    }
+  }
+  return out;
+}
+
+plan::ExplorationResult TareLikePlanner::plan(const plan::ExplorationInput& in) {
+  plan::ExplorationResult r;
+  if (!in.view || !in.graph || !in.clusters || !in.viewpoints || !in.robot_foot_m.allFinite() ||
+      !std::isfinite(in.t_s)) {
+    r.reason = "bad input (null pointer or non-finite pose/time)";
+    return r;
+  }
+  std::vector<Goal> gs = goals(in);
+  if (gs.empty() && (in.graph->root() == graph::kNoId && in.graph->node_count() == 0)) {
+    r.status = plan::ExplorationStatus::kExploring;
+    r.reason = "no graph node at the robot yet";
+    return r;
+  }
+  if (driver_.keep(in, gs, r)) return r;
+  driver_.choose(in, gs, r);
+  return r;
+}
+
+}  // namespace storey::core::baselines
