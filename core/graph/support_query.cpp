@@ -167,11 +167,40 @@ map::Occupancy SupportQuery::walk(const Eigen::Vector3f& from, const Eigen::Vect
   return result;
 }
 
+SupportQuery::ProbeSegment SupportQuery::probe_segment(const Eigen::Vector3f& from,
+                                                       const Eigen::Vector3f& to, int need_free,
+                                                       int* free_total, int* unknown_run) {
+  const VoxelKey start{int32_t(std::floor(from.x() * inv_vs_)),
+                       int32_t(std::floor(from.y() * inv_vs_)), zkey(from.z())};
+  ProbeSegment r;
+  auto visit = [&](const VoxelKey& k) {
+    if (k == start) return true;
+    switch (occupancy(k)) {
+      case Occupancy::kOccupied:
+        r.hit = true;
+        r.hit_key = k;
+        return false;
+      case Occupancy::kFree:
+        ++*free_total;
+        *unknown_run = 0;  // an enclosed hole in known space, not an unknown region
+        return true;
+      case Occupancy::kUnknown:
+        if (*free_total < need_free) {  // did not start in known free space
+          r.closed = true;
+          return false;
+        }
+        ++*unknown_run;
+        return true;
+    }
+    return false;
+  };
+  map::walk_ray(from.x() * inv_vs_, from.y() * inv_vs_, from.z() * inv_vs_, to.x() * inv_vs_,
+                to.y() * inv_vs_, to.z() * inv_vs_, visit);
+  return r;
+}
+
 bool SupportQuery::probe_open(const Eigen::Vector3f& from, const Eigen::Vector3f& to,
                               float min_free_m, float min_unknown_m) {
-  const VoxelKey start{int32_t(std::floor(from.x() * inv_vs_)),
-                       int32_t(std::floor(from.y() * inv_vs_)),
-                       int32_t(std::floor(from.z() * inv_vs_))};
   const Eigen::Vector3f d = to - from;
   const float len = d.norm();
   if (len <= 0) return false;
@@ -180,32 +209,10 @@ bool SupportQuery::probe_open(const Eigen::Vector3f& from, const Eigen::Vector3f
   const int need_free = int(std::ceil(min_free_m * per_m));
   const int need_unknown = std::max(1, int(std::ceil(min_unknown_m * per_m)));
   int free_total = 0, unknown_run = 0;
-  bool hit = false;
-  auto visit = [&](const VoxelKey& k) {
-    if (k == start) return true;
-    switch (occupancy(k)) {
-      case Occupancy::kOccupied:
-        hit = true;
-        return false;
-      case Occupancy::kFree:
-        ++free_total;
-        unknown_run = 0;  // an enclosed hole in known space, not an unknown region
-        return true;
-      case Occupancy::kUnknown:
-        if (free_total < need_free) {  // did not start in known free space
-          hit = true;
-          return false;
-        }
-        ++unknown_run;
-        return true;
-    }
-    return false;
-  };
-  map::walk_ray(from.x() * inv_vs_, from.y() * inv_vs_, from.z() * inv_vs_, to.x() * inv_vs_,
-                to.y() * inv_vs_, to.z() * inv_vs_, visit);
+  const ProbeSegment seg = probe_segment(from, to, need_free, &free_total, &unknown_run);
   // Open: the probe ends inside an unknown region (at least min_unknown_m of it) that it
   // entered from known free space, with no obstacle on the way.
-  return !hit && unknown_run >= need_unknown;
+  return !seg.hit && !seg.closed && unknown_run >= need_unknown;
 }
 
 bool SupportQuery::probe_open_climbing(const Eigen::Vector3f& foot, const Eigen::Vector2f& dir,
@@ -223,35 +230,10 @@ bool SupportQuery::probe_open_climbing(const Eigen::Vector3f& foot, const Eigen:
     const Eigen::Vector3f from(foot.x() + dir.x() * s0, foot.y() + dir.y() * s0, zc + height_m);
     const Eigen::Vector3f to(foot.x() + dir.x() * length_m, foot.y() + dir.y() * length_m,
                              zc + height_m);
-    const VoxelKey start{int32_t(std::floor(from.x() * inv_vs_)),
-                         int32_t(std::floor(from.y() * inv_vs_)), zkey(from.z())};
-    VoxelKey hit{};
-    bool occupied_hit = false, closed = false;
-    auto visit = [&](const VoxelKey& k) {
-      if (k == start) return true;
-      switch (occupancy(k)) {
-        case Occupancy::kOccupied:
-          occupied_hit = true;
-          hit = k;
-          return false;
-        case Occupancy::kFree:
-          ++free_total;
-          unknown_run = 0;
-          return true;
-        case Occupancy::kUnknown:
-          if (free_total < need_free) {
-            closed = true;
-            return false;
-          }
-          ++unknown_run;
-          return true;
-      }
-      return false;
-    };
-    map::walk_ray(from.x() * inv_vs_, from.y() * inv_vs_, from.z() * inv_vs_, to.x() * inv_vs_,
-                  to.y() * inv_vs_, to.z() * inv_vs_, visit);
-    if (closed) return false;
-    if (!occupied_hit) return unknown_run >= need_unknown;
+    const ProbeSegment seg = probe_segment(from, to, need_free, &free_total, &unknown_run);
+    if (seg.closed) return false;
+    if (!seg.hit) return unknown_run >= need_unknown;
+    const VoxelKey& hit = seg.hit_key;
     const float hx = (float(hit.x) + 0.5f) * vs_, hy = (float(hit.y) + 0.5f) * vs_;
     const float s_hit = (Eigen::Vector2f(hx, hy) - foot.head<2>()).dot(dir);
     const std::optional<Support> top = surface_near(hx, hy, zc + 0.5f * max_rise, 0.5f * max_rise);

@@ -107,6 +107,16 @@ class SupportQuery {
   float step() const { return step_; }
 
  private:
+  // One straight leg of a C_exp probe: counts free voxels and the current unknown run (carried
+  // over between legs); stops at the first occupied voxel (hit) or at unknown space met before
+  // need_free free voxels (closed).
+  struct ProbeSegment {
+    bool hit = false, closed = false;
+    map::VoxelKey hit_key{};
+  };
+  ProbeSegment probe_segment(const Eigen::Vector3f& from, const Eigen::Vector3f& to, int need_free,
+                             int* free_total, int* unknown_run);
+
   const map::Cell* cell(const map::VoxelKey& k) { return reader_.cell(k); }
   bool occupied(const map::Cell* c) const {
     return c && (c->flags & map::Cell::kObserved) && c->log_odds > occ_q_;
