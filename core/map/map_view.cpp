@@ -1,6 +1,9 @@
 #include "core/map/map_view.hpp"
 
 #include <algorithm>
+#include <cmath>
+
+#include <algorithm>
 #include <limits>
 
 #include "core/map/voxel_ray.hpp"
@@ -183,6 +186,40 @@ size_t MapView::occupied_in_box(const Eigen::Vector3f& centre, const Eigen::Vect
       for (int32_t z = lo.z; z <= hi.z; ++z)
         if (occupancy_of(r.cell({x, y, z}), occ) == Occupancy::kOccupied)
           out.push_back(centre_of({x, y, z}));
+  return out.size() - before;
+}
+
+size_t MapView::occupied_extents_in_box(const Eigen::Vector3f& centre, const Eigen::Vector3f& half,
+                                        std::vector<VoxelExtent>& out) const {
+  BlockReader& r = reader();
+  const int16_t occ = occ_threshold(*opt_);
+  const VoxelKey lo = key_of(centre - half), hi = key_of(centre + half);
+  const float hs = float(0.5 * opt_->voxel_size_m);
+  const size_t before = out.size();
+  for (int32_t x = lo.x; x <= hi.x; ++x)
+    for (int32_t y = lo.y; y <= hi.y; ++y)
+      for (int32_t z = lo.z; z <= hi.z; ++z) {
+        const VoxelKey k{x, y, z};
+        if (occupancy_of(r.cell(k), occ) != Occupancy::kOccupied) continue;
+        VoxelExtent e;
+        e.centre_m = centre_of(k);
+        e.half_m = Eigen::Vector3f::Constant(hs);
+        e.surface_z_m = e.centre_m.z();
+        const VoxelStats* st = r.stats(k);
+        if (st && st->count) e.surface_z_m += st->mean[2];
+        if (st && st->count >= uint32_t(std::max(1, opt_->n_min))) {
+          const float var[3] = {st->m2[0], st->m2[3], st->m2[5]};  // xx, yy, zz scatter sums
+          for (int a = 0; a < 3; ++a) {
+            const float sd = std::sqrt(std::max(0.0f, var[a] / float(st->count)));
+            const float lo_a = std::max(-hs, st->mean[a] - 2.0f * sd - 0.01f);
+            const float hi_a = std::min(hs, st->mean[a] + 2.0f * sd + 0.01f);
+            if (!(hi_a > lo_a)) continue;  // degenerate: keep the whole voxel on this axis
+            e.centre_m[a] += 0.5f * (lo_a + hi_a);
+            e.half_m[a] = 0.5f * (hi_a - lo_a);
+          }
+        }
+        out.push_back(e);
+      }
   return out.size() - before;
 }
 

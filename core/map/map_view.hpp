@@ -120,6 +120,19 @@ class MapView {
   size_t occupied_in_box(const Eigen::Vector3f& centre_m, const Eigen::Vector3f& half_extent_m,
                          std::vector<Eigen::Vector3f>& out) const;
 
+  // The part of an occupied voxel its points fill, per axis mean +- (2 sd + 1 cm) clipped to the
+  // voxel, where the voxel holds at least n_min points (else the whole voxel on every axis). A
+  // riser seen in a voxel that reaches 9 cm in front of it, or a wall face on a voxel boundary,
+  // is then where the points put it (FCL checks of the body: paper IV-D, Stage 3).
+  struct VoxelExtent {
+    Eigen::Vector3f centre_m = Eigen::Vector3f::Zero();
+    Eigen::Vector3f half_m = Eigen::Vector3f::Zero();
+    float surface_z_m = 0;  // centre z + mean z of the points (as surface_height_m)
+  };
+  size_t occupied_extents_in_box(const Eigen::Vector3f& centre_m,
+                                 const Eigen::Vector3f& half_extent_m,
+                                 std::vector<VoxelExtent>& out) const;
+
   // Iterate occupied voxels: f(key, cell, stats*).
   template <class F>
   void for_each_occupied(F&& f) const {

@@ -130,7 +130,26 @@ TravState TraversabilityMap::evaluate(const VoxelKey& k, VoxelStats* s) {
   const double rough = 1.0 - (ev[1] - ev[0]) / std::max(1e-18, ev[1] + ev[0]);  // r(v), Eq. 1
   const double under = 1.0 - std::min(1.0, n_agg / double(opt_.n_ref));         // u(v)
   // Eq. 2 with s_bar = s / max_slope, r_bar = r, u_bar = u (all 1 at their limits).
-  const double cost = opt_.w_s * slope / robot_.max_slope_rad + opt_.w_r * rough + opt_.w_u * under;
+  double cost = opt_.w_s * slope / robot_.max_slope_rad + opt_.w_r * rough + opt_.w_u * under;
+  // Step edges: where the neighbourhood straddles a stair nosing, the pooled points include the
+  // riser below and the plane fit tilts toward vertical, although v's own points are a flat
+  // tread. If v alone holds a well-spread, level plane, its own slope and roughness stand for
+  // it (the riser voxels keep their vertical fit and stay S_untrav).
+  if (cost > opt_.tau_c && s->count >= uint32_t(opt_.n_min)) {
+    const double n = s->count;
+    Eigen::Matrix3d own;
+    own << s->m2[0], s->m2[1], s->m2[2], s->m2[1], s->m2[3], s->m2[4], s->m2[2], s->m2[4], s->m2[5];
+    own /= n;
+    es.computeDirect(own);
+    const Eigen::Vector3d oev = es.eigenvalues().cwiseMax(0.0);
+    if (oev[2] > 0 && oev[1] >= 1e-2 * oev[2]) {  // not collinear
+      const double oslope = std::acos(std::min(1.0, std::abs(es.eigenvectors().col(0).z())));
+      const double orough = 1.0 - (oev[1] - oev[0]) / std::max(1e-18, oev[1] + oev[0]);
+      if (oslope <= 0.5 * robot_.max_slope_rad)
+        cost = std::min(
+            cost, opt_.w_s * oslope / robot_.max_slope_rad + opt_.w_r * orough + opt_.w_u * under);
+    }
+  }
   s->cost = float(cost);
   s->normal_z = float(std::abs(nrm.z()));
   if (cost > opt_.tau_c) s->reasons |= VoxelStats::kReasonCost;

@@ -12,11 +12,12 @@
 namespace storey::core::plan {
 
 struct CollisionChecker::Impl {
-  std::shared_ptr<fcl::Boxd> voxel_geom;
   std::shared_ptr<fcl::Boxd> body_geom;
   std::unique_ptr<fcl::CollisionObjectd> body;
-  // Voxel objects are pooled and re-positioned, never re-created once the pool has grown.
+  // Voxel objects are pooled and re-positioned, never re-created once the pool has grown;
+  // each has its own box (fitted to the voxel's points, MapView::VoxelExtent).
   std::vector<std::unique_ptr<fcl::CollisionObjectd>> pool;
+  std::vector<std::shared_ptr<fcl::Boxd>> pool_geom;
   std::vector<fcl::CollisionObjectd*> active;
   std::vector<float> surface_z;  // parallel to active
   fcl::DynamicAABBTreeCollisionManagerd manager;
@@ -67,7 +68,6 @@ CollisionChecker::CollisionChecker(const RobotModel& robot, double voxel_size_m,
   box_m_ = Eigen::Vector3d(robot.body_length_m + 2 * m, robot.body_width_m + 2 * m,
                            robot.body_height_m + m);
   max_spacing_m_ = 0.5 * box_m_.minCoeff();
-  impl_->voxel_geom = std::make_shared<fcl::Boxd>(voxel_m_, voxel_m_, voxel_m_);
   impl_->body_geom = std::make_shared<fcl::Boxd>(box_m_.x(), box_m_.y(), box_m_.z());
   impl_->body = std::make_unique<fcl::CollisionObjectd>(impl_->body_geom);
 }
@@ -83,23 +83,26 @@ double CollisionChecker::max_dt_s() const {
   return spacing / sweep_speed;
 }
 
-void CollisionChecker::load_voxels(std::span<const Eigen::Vector3f> centres,
-                                   std::span<const float> surface_z, double ground_below_z) {
+void CollisionChecker::load_voxels(std::span<const map::MapView::VoxelExtent> voxels,
+                                   double ground_below_z) {
   Impl& im = *impl_;
   im.manager.clear();
   im.active.clear();
   im.surface_z.clear();
-  for (size_t k = 0; k < centres.size(); ++k) {
-    const Eigen::Vector3f& c = centres[k];
-    const float zs = k < surface_z.size() ? surface_z[k] : c.z();
-    if (double(zs) < ground_below_z) continue;  // ground for every pose of this group
+  for (const map::MapView::VoxelExtent& v : voxels) {
+    if (double(v.surface_z_m) < ground_below_z) continue;  // ground for every pose of the group
     const size_t i = im.active.size();
-    if (i == im.pool.size())
-      im.pool.push_back(std::make_unique<fcl::CollisionObjectd>(im.voxel_geom));
+    if (i == im.pool.size()) {
+      im.pool_geom.push_back(std::make_shared<fcl::Boxd>(voxel_m_, voxel_m_, voxel_m_));
+      im.pool.push_back(std::make_unique<fcl::CollisionObjectd>(im.pool_geom.back()));
+    }
+    fcl::Boxd& g = *im.pool_geom[i];
+    g.side = 2.0 * v.half_m.cast<double>();
+    g.computeLocalAABB();
     fcl::CollisionObjectd* o = im.pool[i].get();
-    o->setTranslation(c.cast<double>());
+    o->setTranslation(v.centre_m.cast<double>());
     o->setUserData(reinterpret_cast<void*>(uintptr_t(i)));
-    im.surface_z.push_back(zs);
+    im.surface_z.push_back(v.surface_z_m);
     o->computeAABB();
     im.active.push_back(o);
   }
@@ -139,7 +142,10 @@ CollisionHit CollisionChecker::check_poses(std::span<const BodyPose> poses,
     }
     ground = std::min(ground, ground_floor_z(poses[i]));
   }
-  load_voxels(voxel_centres_m, {}, ground);
+  extents_.clear();
+  for (const Eigen::Vector3f& c : voxel_centres_m)
+    extents_.push_back({c, Eigen::Vector3f::Constant(float(0.5 * voxel_m_)), c.z()});
+  load_voxels(extents_, ground);
   h.voxels_loaded = uint32_t(impl_->active.size());
   for (size_t i = 0; i < poses.size(); ++i) {
     ++h.poses_checked;
@@ -215,13 +221,10 @@ CollisionHit CollisionChecker::check_poses(const map::MapView& view,
     // Padded by the half diagonal: covers the box at any yaw and at pitches up to 90 deg.
     const Eigen::Vector3d blo = lo - Eigen::Vector3d::Constant(pad);
     const Eigen::Vector3d bhi = hi + Eigen::Vector3d(pad, pad, box_m_.z() + pad);
-    centres_.clear();
-    view.occupied_in_box(((blo + bhi) * 0.5).cast<float>(), ((bhi - blo) * 0.5).cast<float>(),
-                         centres_);
-    surface_z_.clear();
-    for (const Eigen::Vector3f& c : centres_)
-      surface_z_.push_back(view.surface_height_m(view.key_of(c)).value_or(c.z()));
-    load_voxels(centres_, surface_z_, ground);
+    extents_.clear();
+    view.occupied_extents_in_box(((blo + bhi) * 0.5).cast<float>(),
+                                 ((bhi - blo) * 0.5).cast<float>(), extents_);
+    load_voxels(extents_, ground);
     h.voxels_loaded += uint32_t(impl_->active.size());
     for (size_t k = i; k < j; ++k) {
       ++h.poses_checked;

@@ -115,8 +115,7 @@ class CollisionChecker {
  private:
   struct Impl;
   bool collide_one(const BodyPose& p, Eigen::Vector3d* voxel);
-  void load_voxels(std::span<const Eigen::Vector3f> centres, std::span<const float> surface_z,
-                   double ground_below_z);
+  void load_voxels(std::span<const map::MapView::VoxelExtent> voxels, double ground_below_z);
   // World z below which a voxel centre is ground for pose p wherever it is under the body.
   double ground_floor_z(const BodyPose& p) const;
 
@@ -128,8 +127,7 @@ class CollisionChecker {
   std::unique_ptr<Impl> impl_;
   std::vector<BodyPose> samples_;
   std::vector<BodyPose> adjusted_;
-  std::vector<Eigen::Vector3f> centres_;
-  std::vector<float> surface_z_;
+  std::vector<map::MapView::VoxelExtent> extents_;
 };
 
 }  // namespace storey::core::plan

@@ -201,3 +201,27 @@ TEST(Terrain, TableTopIsTraversableButNotReachable) {
   const Tally floor = tally(m, -1.0f, 0.5f, -1.0f, 1.0f, [](float, float) { return 0.03f; });
   EXPECT_GE(floor.reach, floor.samples * 90 / 100) << floor.str();
 }
+
+TEST(Terrain, FlatTreadNextToARiserKeepsItsOwnLevelPlane) {
+  // A tread top at z = 0.505 (just above a voxel boundary) from x = 0.29 on; the riser below
+  // its nosing at x = 0.29 (z 0.34..0.5) and the lower tread (z 0.338) before it, as a LiDAR
+  // sees a stair from its foot: many riser points, few on the tread. Pooled over the 0.2 m
+  // neighbourhood the plane tilts toward the riser; the tread voxel's own points are level.
+  TraversabilityMap m;
+  std::vector<Vector3f> pts;
+  for (float y = -0.3f; y <= 0.3f; y += 0.02f) {
+    for (float z = 0.345f; z < 0.5f; z += 0.01f) pts.emplace_back(0.291f, y, z);  // riser
+    for (float x = 0.31f; x < 0.39f; x += 0.03f) pts.emplace_back(x, y, 0.505f);  // tread top
+    for (float x = 0.02f; x < 0.28f; x += 0.05f) pts.emplace_back(x, y, 0.338f);  // lower tread
+  }
+  for (int rep = 0; rep < 3; ++rep) m.insert_scan(Vector3f(-0.8f, 0, 0.9f), pts);
+  m.update_traversability();
+  const MapView v = m.view();
+  const auto s = v.support_surface_near(Vector3f(0.35f, 0.05f, 0.505f), 0.05);
+  ASSERT_TRUE(s.has_value());
+  EXPECT_NEAR(s->height_m, 0.505f, 0.02f);
+  EXPECT_EQ(s->state, TravState::kTraversable);
+  // The riser's own voxels stay untraversable (vertical points, or not a top surface).
+  const auto r = v.support_surface_near(Vector3f(0.25f, 0.05f, 0.45f), 0.05);
+  if (r) EXPECT_NE(r->state, TravState::kTraversable);
+}

@@ -155,3 +155,31 @@ TEST(PathCentring, FootOfAFlightIsReachableOnASparseMap) {
   const BodyPose inside{{0.5, 0.0, 0.0}, 0.0, 0.0, 0.0};
   EXPECT_TRUE(cc.check_poses(view, std::span<const BodyPose>(&inside, 1)).collides);
 }
+
+TEST(PathCentring, VoxelBoxesAreFittedToTheirPoints) {
+  // A wall face at x = 2.09: its points fill the voxel [2.0, 2.1) only in its last centimetre.
+  map::TraversabilityMap m;
+  std::vector<Eigen::Vector3f> pts;
+  for (float y = -1.0f; y <= 1.0f; y += 0.02f) {
+    for (float z = 0.02f; z < 1.0f; z += 0.02f) pts.emplace_back(2.09f, y, z);
+    for (float x = -1.0f; x < 2.08f; x += 0.05f) pts.emplace_back(x, y, -0.005f);  // floor
+  }
+  for (int rep = 0; rep < 3; ++rep) m.insert_scan(Eigen::Vector3f(0, 0, 0.5f), pts);
+  m.update_traversability();
+  const map::MapView view = m.view();
+  std::vector<map::MapView::VoxelExtent> ext;
+  view.occupied_extents_in_box({2.05f, 0.05f, 0.45f}, {0.01f, 0.01f, 0.01f}, ext);
+  ASSERT_EQ(ext.size(), 1u);
+  EXPECT_NEAR(ext[0].centre_m.x(), 2.09f, 0.015f);
+  EXPECT_LT(ext[0].half_m.x(), 0.025f);
+  EXPECT_NEAR(ext[0].half_m.y(), 0.05f, 0.02f);  // spread over the voxel along the face
+  // The body 3 cm short of the face (its box, margin included, ends at 2.06) does not collide;
+  // 3 cm into it, it does.
+  CollisionChecker cc(RobotModel{}, view.voxel_size_m());
+  const RobotModel robot;
+  const double front = 0.5 * robot.body_length_m + robot.body_margin_m;
+  const BodyPose near{{2.06 - front, 0.0, 0.0}, 0.0, 0.0, 0.0};
+  const BodyPose into{{2.12 - front, 0.0, 0.0}, 0.0, 0.0, 0.0};
+  EXPECT_FALSE(cc.check_poses(view, std::span<const BodyPose>(&near, 1)).collides);
+  EXPECT_TRUE(cc.check_poses(view, std::span<const BodyPose>(&into, 1)).collides);
+}
