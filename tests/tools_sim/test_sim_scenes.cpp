@@ -169,7 +169,8 @@ TEST(SimMetrics, CoverageCountsOneVoxelVerticalTolerance) {
        {"\"success\"", "\"floors_total\"", "\"floors_explored\"", "\"exploration_time_s\"",
         "\"trajectory_length_m\"", "\"traversable_volume_m3\"", "\"occupied_volume_m3\"",
         "\"traversable_coverage\"", "\"per_floor\"", "\"time_s\"", "\"collisions\"", "\"falls\"",
-        "\"safety_stops\"", "\"latency\""})
+        "\"safety_stops\"", "\"latency\"", "\"method\"", "\"ablation\"", "\"completed\"",
+        "\"end_reason\""})
     EXPECT_NE(j.find(key), std::string::npos) << key;
 }
 

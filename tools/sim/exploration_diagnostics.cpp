@@ -81,9 +81,12 @@ std::string exploration_diagnostics(const firmware::Autonomy& autonomy, const Gr
   }
   std::map<std::string, int> reasons;
   for (const auto& e : planner.set_aside()) ++reasons[core::plan::to_string(e.reason)];
-  out += "Set-aside frontier nodes over the run: " + std::to_string(planner.set_aside().size());
+  // Entries expire when the map near them changes: the list is what is set aside now.
+  out += "Set-aside frontier nodes at the end: " + std::to_string(planner.set_aside().size());
   for (const auto& [k, v] : reasons) out += ", " + k + " " + std::to_string(v);
-  out += "\n\n";
+  out += " (" + std::to_string(planner.set_aside().size() + planner.set_aside_expired()) +
+         " over the run, " + std::to_string(planner.set_aside_expired()) +
+         " expired when the map near them changed)\n\n";
 
   // ---- 2. Coverage gaps: what the map holds at uncovered ground-truth traversable voxels.
   const auto& map = autonomy.map_for_record();
