@@ -119,6 +119,7 @@ void read_graph(SectionReader&& r, core::graph::GraphOptions& o) {
   r.get("max_gap_m", o.max_gap_m, Range{0.0, 5.0});
   r.get("surface_tolerance_m", o.surface_tolerance_m, Range{0.0, 0.5});
   r.get("root_radius_m", o.root_radius_m, Range{0.05, 10.0});
+  r.get("prune_persistence_updates", o.prune_persistence_updates, Range{0, 100000});
   r.get("floor_height_hint_m", o.floor_height_hint_m, Range{1.0, 20.0});
   r.get("max_expansions_per_update", o.max_expansions_per_update, Range{1, 1000000});
   r.get("max_revalidations_per_update", o.max_revalidations_per_update, Range{1, 10000000});

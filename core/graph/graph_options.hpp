@@ -35,6 +35,10 @@ struct GraphOptions {
   double surface_tolerance_m = 0.03;  // slack on the step height for surface noise
   double root_radius_m = 1.0;         // the robot's node: nearest within this, else a new one
   double floor_height_hint_m = 3.0;   // floor id hint = round(z / this) (planning refines floors)
+  // A cut that leaves the robot in the smaller part is more likely a transient (a node near the
+  // robot lost and not yet re-linked) than a real one: the larger part is kept this many updates
+  // before it is pruned (a real cut, e.g. a closed door, still prunes it after the window).
+  int prune_persistence_updates = 30;
   // --- incremental update budgets (bounded work per map cycle) ---
   // (~23 us per operation at 0.1 m voxels: these bound a cycle to ~5 ms CPU; PERFORMANCE.md)
   int max_expansions_per_update = 40;     // nodes expanded per update (queue carries over)

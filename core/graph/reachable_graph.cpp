@@ -386,7 +386,8 @@ NodeId ReachableGraph::attach_root(SupportQuery& q, const Eigen::Vector3f& foot,
 }
 
 // After removals: BFS from the robot's node; whatever it does not reach is no longer part of
-// the reachable support structure (Sec. III-B).
+// the reachable support structure (Sec. III-B). A cut that leaves the robot in the smaller part
+// waits GraphOptions::prune_persistence_updates for the link to come back before pruning.
 void ReachableGraph::prune_disconnected(GraphUpdateStats& st) {
   if (root_ == kNoId) return;
   if (nodes_[root_].degree == 0 && node_count_ > 1) {
@@ -411,7 +412,16 @@ void ReachableGraph::prune_disconnected(GraphUpdateStats& st) {
       }
     }
   }
-  if (bfs_.size() == node_count_) return;
+  if (bfs_.size() == node_count_) {
+    deferred_updates_ = 0;
+    return;
+  }
+  if (2 * bfs_.size() < node_count_ && deferred_updates_ < opt_.prune_persistence_updates) {
+    ++deferred_updates_;
+    st.prune_deferred = true;
+    return;
+  }
+  deferred_updates_ = 0;
   for (NodeId i = 0; i < nodes_.size(); ++i)
     if (nodes_[i].alive && mark_[i] != mark_epoch_) {
       remove_node(i);
@@ -470,7 +480,7 @@ GraphUpdateStats ReachableGraph::update(const map::MapView& view, const Eigen::V
   }
 
   // 5. Components cut off from the robot.
-  if (connectivity_lost_) prune_disconnected(st);
+  if (connectivity_lost_ || deferred_updates_ > 0) prune_disconnected(st);
   st.pending_revalidations = uint32_t(reval_q_.size());
   st.pending_expansions = uint32_t(expand_q_.size());
   return st;

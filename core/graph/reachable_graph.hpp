@@ -88,9 +88,10 @@ struct GraphUpdateStats {
   uint32_t nodes_added = 0, edges_added = 0;
   uint32_t nodes_pruned = 0;  // removed: support lost, new obstacle, fall risk
   uint32_t edges_pruned = 0;
-  uint32_t promoted = 0;      // S_tent -> S_conf (nodes and edges)
-  uint32_t demoted = 0;       // S_conf -> S_tent (left C_reach but still valid)
-  uint32_t disconnected = 0;  // nodes removed by the BFS from the robot
+  uint32_t promoted = 0;        // S_tent -> S_conf (nodes and edges)
+  uint32_t demoted = 0;         // S_conf -> S_tent (left C_reach but still valid)
+  uint32_t disconnected = 0;    // nodes removed by the BFS from the robot
+  bool prune_deferred = false;  // cut off from the robot but the larger part: kept for now
   uint32_t pending_revalidations = 0, pending_expansions = 0;  // carried over
   uint32_t rejects[int(Reject::kCount)] = {};  // candidate nodes / edges rejected, by reason
   bool has_root = false;
@@ -118,7 +119,7 @@ class ReachableGraph {
   void request_expand(NodeId i) {
     if (i < nodes_.size() && nodes_[i].alive) queue_expand(i);
   }
-  bool idle() const { return expand_q_.empty() && reval_q_.empty(); }
+  bool idle() const { return expand_q_.empty() && reval_q_.empty() && deferred_updates_ == 0; }
 
   const GraphNode& node(NodeId i) const { return nodes_[i]; }
   const GraphEdge& edge(EdgeId e) const { return edges_[e]; }
@@ -166,6 +167,7 @@ class ReachableGraph {
   size_t node_count_ = 0, edge_count_ = 0;
   NodeId root_ = kNoId;
   bool connectivity_lost_ = false;
+  int deferred_updates_ = 0;  // updates the current cut has been deferred (0: none pending)
   std::deque<NodeId> expand_q_, reval_q_;
   std::vector<NodeId> touched_;
   // Spatial hash over nodes: cubic cells of r_e.

@@ -434,7 +434,7 @@ namespace {
 TEST(ConfigSchema, CoreOptionStructsAreFullyMapped) {
   EXPECT_EQ(sizeof(core::RobotModel), 80u) << "RobotModel changed: update the config schema";
   EXPECT_EQ(sizeof(core::map::MapOptions), 144u) << "MapOptions changed: update the config schema";
-  EXPECT_EQ(sizeof(core::graph::GraphOptions), 192u)
+  EXPECT_EQ(sizeof(core::graph::GraphOptions), 200u)
       << "GraphOptions changed: update the config schema";
   EXPECT_EQ(sizeof(core::plan::PlanOptions), 216u)
       << "PlanOptions changed: update the config schema";

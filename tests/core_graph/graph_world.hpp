@@ -78,6 +78,7 @@ struct Harness {
   std::mt19937_64 rng;
   Eigen::Vector3f foot = Eigen::Vector3f::Zero();
   core::graph::GraphUpdateStats last;
+  int settle_cycles = 200;  // graph cycles observe() runs after the scan's (0: just the one)
 
   explicit Harness(const core::graph::GraphOptions& o = {}, uint64_t seed = 1)
       : graph(o), frontiers(o), rng(seed) {}
@@ -95,7 +96,7 @@ struct Harness {
     last = graph.update(map.view(), foot, std::span(&box, 1), rng);
     frontiers.update(graph, map.view(), foot, std::span(&box, 1), std::span(&box, 1));
     for (int r = 0; r < int(core::graph::Reject::kCount); ++r) rejects[r] += last.rejects[r];
-    settle();
+    settle(settle_cycles);
     if (getenv("STOREY_DEBUG"))
       printf(
           "observe at %.2f %.2f %.2f: nodes %zu edges %zu reach %lu | pruned %u disc %u "

@@ -315,6 +315,30 @@ TEST(ReachableGraph, CuttingTheCorridorRemovesTheFarComponent) {
   EXPECT_GT(s.h.last.disconnected, 0u);
 }
 
+// A cut that leaves the robot in the smaller part is held for prune_persistence_updates
+// (a transient loss of the link near the robot must not wipe the explored graph), then pruned.
+TEST(ReachableGraph, CutLeavingTheRobotInTheSmallerPartWaitsBeforePruning) {
+  GraphOptions o;
+  o.prune_persistence_updates = 12;
+  GapScenario s(o);
+  s.h.observe(s.w, Vector3f(6, 0, 0.55f), Vector3f(0, 0, 0), 60000, 14, 4.0f);
+  const int far_before = s.count(5.2f, 15.0f);
+  ASSERT_GT(far_before, s.count(-2.0f, 4.5f)) << "the scenario needs the far part larger";
+  s.w.add({5.0f, -1.0f, 0.0f}, {5.2f, 1.0f, 2.5f});
+  s.h.settle_cycles = 0;
+  s.h.observe(s.w, Vector3f(4, 0, 0.55f), Vector3f(0, 0, 0), 60000, 31, 4.0f);
+  int deferred = 0;
+  for (int i = 0; i < 200 && !s.h.graph.idle() && s.count(5.2f, 15.0f) > 0; ++i) {
+    const auto st = s.h.graph.update(s.h.map.view(), s.h.foot, {}, s.h.rng);
+    deferred += st.prune_deferred;
+    if (st.prune_deferred) EXPECT_GT(s.count(5.2f, 15.0f), 0);
+  }
+  EXPECT_GT(deferred, 0) << "the cut was pruned at once";
+  EXPECT_LE(deferred, o.prune_persistence_updates);
+  EXPECT_EQ(s.count(5.2f, 15.0f), 0) << "a lasting cut must still be pruned";
+  EXPECT_GT(s.count(-2.0f, 4.5f), 8);
+}
+
 TEST(MapChangeDetector, ReportsWhereTheMapChangedAndWhatWasRemoved) {
   World w = corridor();
   storey::core::map::TraversabilityMap m;
