@@ -68,11 +68,11 @@ uint16_t frontier_signature(const graph::GraphNode& n) {
 }
 
 void LocalPlanner::set_aside_cluster(const LocalPlanInput& in, const graph::FrontierCluster& c,
-                                     SetAsideReason reason) {
+                                     SetAsideReason reason, const Eigen::Vector3f& hit_m) {
   const graph::ReachableGraph& g = *in.graph;
   for (graph::NodeId n : c.nodes)
     set_aside_.push_back({g.node(n).p_m, in.t_s, c.id, reason, in.robot_foot_m.cast<float>(),
-                          frontier_signature(g.node(n))});
+                          frontier_signature(g.node(n)), hit_m});
 }
 
 // A set-aside node means "not resolvable from where the robot can stand, on the map as it was
@@ -223,6 +223,7 @@ bool LocalPlanner::escape(const LocalPlanInput& in, LocalPlanResult& out) {
 bool LocalPlanner::try_target(const LocalPlanInput& in, const Viewpoint& vp, LocalPlanResult& out,
                               SetAsideReason* why) {
   *why = SetAsideReason::kAstarFailed;
+  last_hit_m_ = kNoHit;
   ++out.astar_calls;
   VoxelPath path = astar_.plan(*in.view, start_foot_m_, vp.p_m);
   // The ground under the feet may be in the LiDAR's blind ring (start-up): search from the
@@ -260,12 +261,15 @@ bool LocalPlanner::try_target(const LocalPlanInput& in, const Viewpoint& vp, Loc
   double goal_yaw = shape_path(*in.view, path.points_m, vp.yaw_rad);
   TrajectoryResult tr =
       builder_.build(*in.view, checker_, path.points_m, start_yaw_, goal_yaw, in.t_s);
-  if (tr.status != TrajectoryStatus::kOk && tr.status != TrajectoryStatus::kPolyline) {
+  auto failed = [&]() {
+    if (tr.hit.collides) last_hit_m_ = tr.hit.voxel_m.cast<float>();
+    return tr.status != TrajectoryStatus::kOk && tr.status != TrajectoryStatus::kPolyline;
+  };
+  if (failed()) {
     if (on_graph || !graph_path()) return false;
     goal_yaw = shape_path(*in.view, path.points_m, vp.yaw_rad);
     tr = builder_.build(*in.view, checker_, path.points_m, start_yaw_, goal_yaw, in.t_s);
-    if (tr.status != TrajectoryStatus::kOk && tr.status != TrajectoryStatus::kPolyline)
-      return false;
+    if (failed()) return false;
   }
   out.trajectory = std::move(tr.trajectory);
   out.path_m = std::move(path.points_m);
@@ -481,7 +485,12 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     return out;
   }
   int attempts = 0;
-  std::vector<std::pair<size_t, SetAsideReason>> failed;  // (index into order, why)
+  struct Failed {
+    size_t m;  // index into order
+    SetAsideReason why;
+    Eigen::Vector3f hit_m;
+  };
+  std::vector<Failed> failed;
   for (size_t m = 0; m < order.size() && attempts < opt_.max_stage3_attempts; ++m) {
     const Candidate& c = sel[order[m]];
     std::vector<Viewpoint> vps = m < window.size() ? window[m] : viewpoints_of(c);
@@ -502,7 +511,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
       out.status = LocalPlanStatus::kNewTrajectory;
       return out;
     }
-    failed.push_back({m, why});
+    failed.push_back({m, why, last_hit_m_});
   }
   // Every attempt failed. If the robot cannot turn where it stands (a dead end narrower than
   // the body's turning circle: every path back starts with a turn), the clusters are not to
@@ -518,13 +527,13 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     return out;
   }
   // Stage 3 failed for these clusters: after max_failures cycles a cluster is set aside.
-  for (const auto& [m, why] : failed) {
+  for (const auto& [m, why, hit_m] : failed) {
     const Candidate& c = sel[order[m]];
     auto it = std::find_if(failures_.begin(), failures_.end(),
                            [&](const auto& f) { return f.first == c.cluster_id; });
     if (it == failures_.end()) it = failures_.insert(failures_.end(), {c.cluster_id, 0});
     if (++it->second >= opt_.max_failures) {
-      set_aside_cluster(in, (*in.clusters)[c.cluster_index], why);
+      set_aside_cluster(in, (*in.clusters)[c.cluster_index], why, hit_m);
       failures_.erase(it);
     }
   }

@@ -18,6 +18,7 @@
 // Single-threaded: the firmware's plan task owns it. The macro layer (ExplorationPlanner) can
 // replace or wrap it: the interface is the one plan(input) -> result call.
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -93,6 +94,8 @@ struct SetAsideEntry {
   SetAsideReason reason = SetAsideReason::kStillFrontierAtTarget;
   Eigen::Vector3f robot_m = Eigen::Vector3f::Zero();  // robot foot point then
   uint16_t frontier_sig = 0;  // the node's frontier flags then (frontier_signature())
+  // kTrajectoryFailed: a voxel the body hit on the last try (NaN otherwise): diagnostics.
+  Eigen::Vector3f hit_m = Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
 };
 // C_sur, C_exp, boundary and |Theta_open| of a node packed: what TopologicalFrontiers
 // recomputes when the map near the node changes.
@@ -135,7 +138,9 @@ class LocalPlanner {
   };
   bool ignored(const Eigen::Vector3f& p) const { return set_aside_at(p) != nullptr; }
   void set_aside_cluster(const LocalPlanInput& in, const graph::FrontierCluster& c,
-                         SetAsideReason reason);
+                         SetAsideReason reason, const Eigen::Vector3f& hit_m = kNoHit);
+  static inline const Eigen::Vector3f kNoHit =
+      Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
   int expire_set_aside(const LocalPlanInput& in);
   const graph::FrontierCluster* find_cluster(const LocalPlanInput& in, int32_t id) const;
   void build_search_graph(const graph::ReachableGraph& g);
@@ -175,6 +180,7 @@ class LocalPlanner {
   uint64_t expired_total_ = 0;
   std::vector<graph::NodeId> near_scratch_;
   std::vector<std::pair<int32_t, int>> failures_;
+  Eigen::Vector3f last_hit_m_ = kNoHit;  // try_target: where the last B-spline collided
   std::vector<int32_t>
       approached_;  // clusters whose viewpoint was reached once (walk onto them next)
 };

@@ -20,6 +20,17 @@ bool obstacle_at(const map::MapView& view, int32_t kx, int32_t ky, double h) {
   return false;
 }
 
+// A step between consecutive path points that climbs a flight (a rise over the step's half
+// height, steeper than 0.6 max_slope: stairs' mean grade is ~30 deg, ramps for legged robots
+// stay under ~15 deg). A ramp's points are centred and shaped like level ones, with the
+// ground following the ramp's grade.
+bool flight_step(const RobotModel& r, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                 double voxel_m) {
+  const double dz = std::abs(b.z() - a.z());
+  if (dz <= 0.5 * r.step_height_m) return false;
+  return dz > std::tan(0.6 * r.max_slope_rad) * std::max((b - a).head<2>().norm(), voxel_m);
+}
+
 }  // namespace
 
 PathCentringStats centre_path(const map::MapView& view, std::vector<Eigen::Vector3d>& points,
@@ -41,17 +52,24 @@ PathCentringStats centre_path(const map::MapView& view, std::vector<Eigen::Vecto
     const Eigen::Vector3d p = original[i];
     // On a flight (a neighbour a level away) the treads ahead would read as obstacles: the
     // flight's own shaping (shape_flights) centres it.
-    if (std::abs(original[i - 1].z() - p.z()) > 0.5 * r.step_height_m ||
-        std::abs(original[i + 1].z() - p.z()) > 0.5 * r.step_height_m)
-      continue;
+    if (flight_step(r, original[i - 1], p, s) || flight_step(r, p, original[i + 1], s)) continue;
+    // The ground's grade along the path (a ramp; zero on level ground): a column's ground is
+    // expected at p.z() + grade . (column - p).
+    const Eigen::Vector2d span = (original[i + 1] - original[i - 1]).head<2>();
+    const Eigen::Vector2d grade =
+        span.norm() > 1e-6 ? Eigen::Vector2d(span * ((original[i + 1].z() - original[i - 1].z()) /
+                                                     span.squaredNorm()))
+                           : Eigen::Vector2d::Zero();
     const int32_t cx = int32_t(std::floor(p.x() / s)), cy = int32_t(std::floor(p.y() / s));
     // Obstacle columns around the point, at its own level (stairs: each tread has its own band).
     obstacles.clear();
     for (int dx = -rv; dx <= rv; ++dx)
-      for (int dy = -rv; dy <= rv; ++dy)
+      for (int dy = -rv; dy <= rv; ++dy) {
+        const Eigen::Vector2d c((cx + dx + 0.5) * s, (cy + dy + 0.5) * s);
         if ((dx * dx + dy * dy) * s * s <= reach * reach &&
-            obstacle_at(view, cx + dx, cy + dy, p.z()))
-          obstacles.emplace_back((cx + dx + 0.5) * s, (cy + dy + 0.5) * s);
+            obstacle_at(view, cx + dx, cy + dy, p.z() + grade.dot(c - p.head<2>())))
+          obstacles.push_back(c);
+      }
     if (obstacles.empty()) continue;
     // Clearance of a position: distance to the nearest obstacle voxel's near side.
     auto clear = [&](const Eigen::Vector2d& q) {
@@ -78,6 +96,7 @@ PathCentringStats centre_path(const map::MapView& view, std::vector<Eigen::Vecto
       if (-neg <= score0 + 1e-9) break;  // no better than staying
       Eigen::Vector3d q = p;
       q.head<2>() += off;
+      q.z() += grade.dot(off);
       const auto sp = view.support_surface_near(q.cast<float>(), r.step_height_m);
       if (!sp || !(sp->reachable || sp->state == map::TravState::kTraversable ||
                    sp->state == map::TravState::kUnobserved))
@@ -193,12 +212,12 @@ FlightShaping shape_flights(const map::MapView& view, std::vector<Eigen::Vector3
   const double half_w = 0.5 * r.body_width_m + r.body_margin_m;
   const double level = 0.5 * r.step_height_m;
   for (size_t j = 1; j + 1 < points.size(); ++j) {
-    if (std::abs(points[j + 1].z() - points[j].z()) <= level) continue;
+    if (!flight_step(r, points[j], points[j + 1], s)) continue;
     const double sign = points[j + 1].z() > points[j].z() ? 1.0 : -1.0;
     // The flight's extent in the path: it ends where the path stays level for a run-up.
     size_t e = j + 1, level_from = j + 1;
     while (e + 1 < points.size()) {
-      if (std::abs(points[e + 1].z() - points[e].z()) > level)
+      if (flight_step(r, points[e], points[e + 1], s))
         level_from = e + 1;
       else if ((points[e + 1] - points[level_from]).head<2>().norm() >= run_up)
         break;

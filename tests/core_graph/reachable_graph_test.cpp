@@ -331,7 +331,9 @@ TEST(ReachableGraph, CutLeavingTheRobotInTheSmallerPartWaitsBeforePruning) {
   for (int i = 0; i < 200 && !s.h.graph.idle() && s.count(5.2f, 15.0f) > 0; ++i) {
     const auto st = s.h.graph.update(s.h.map.view(), s.h.foot, {}, s.h.rng);
     deferred += st.prune_deferred;
-    if (st.prune_deferred) EXPECT_GT(s.count(5.2f, 15.0f), 0);
+    if (st.prune_deferred) {
+      EXPECT_GT(s.count(5.2f, 15.0f), 0);
+    }
   }
   EXPECT_GT(deferred, 0) << "the cut was pruned at once";
   EXPECT_LE(deferred, o.prune_persistence_updates);

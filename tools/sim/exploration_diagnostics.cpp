@@ -73,7 +73,10 @@ std::string exploration_diagnostics(const firmware::Autonomy& autonomy, const Gr
                (n.state == core::graph::ElementState::kConfirmed ? "conf" : "tent") + " | " +
                (n.c_sur ? "yes" : "no") + f(" (%.2f)", n.rho) + " | " + (n.c_exp ? "yes" : "no") +
                " (" + std::to_string(n.open_dirs) + ") | " + f("%.1f", (n.p_m - r).norm()) + " | " +
-               (e ? std::string(core::plan::to_string(e->reason)) + f(" at %.1f s", e->t_s)
+               (e ? std::string(core::plan::to_string(e->reason)) + f(" at %.1f s", e->t_s) +
+                        (e->hit_m.allFinite() ? f(" (body hit %.2f, %.2f, %.2f)", e->hit_m.x(),
+                                                  e->hit_m.y(), e->hit_m.z())
+                                              : std::string())
                   : std::string("-")) +
                " |\n";
       }
