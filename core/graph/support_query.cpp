@@ -217,9 +217,8 @@ bool SupportQuery::probe_open(const Eigen::Vector3f& from, const Eigen::Vector3f
 
 bool SupportQuery::probe_open_climbing(const Eigen::Vector3f& foot, const Eigen::Vector2f& dir,
                                        float length_m, float height_m, float min_free_m,
-                                       float min_unknown_m, bool* climbed) {
+                                       float min_unknown_m) {
   constexpr int kMaxClimbs = 24;
-  if (climbed) *climbed = false;
   // Horizontal probe: |dx| + |dy| voxels per metre (6-connected walk).
   const float per_m = (std::abs(dir.x()) + std::abs(dir.y())) * inv_vs_;
   const int need_free = int(std::ceil(min_free_m * per_m));
@@ -233,7 +232,6 @@ bool SupportQuery::probe_open_climbing(const Eigen::Vector3f& foot, const Eigen:
                              zc + height_m);
     const ProbeSegment seg = probe_segment(from, to, need_free, &free_total, &unknown_run);
     if (seg.closed) return false;
-    if (climbed) *climbed = climb > 0;
     if (!seg.hit) return unknown_run >= need_unknown;
     const VoxelKey& hit = seg.hit_key;
     const float hx = (float(hit.x) + 0.5f) * vs_, hy = (float(hit.y) + 0.5f) * vs_;
@@ -244,7 +242,6 @@ bool SupportQuery::probe_open_climbing(const Eigen::Vector3f& foot, const Eigen:
         rise <= step_ + tan_slope_ * std::max(0.0f, s_hit - s_climb)) {
       // A step up onto support the LiDAR saw only edge-on (a tread seen from below: its
       // riser's top, N(v) < N_min): terrain not yet observed, what the probe looks for.
-      if (climbed) *climbed = true;
       if (top->state == TravState::kUnobserved) return free_total >= need_free;
       zc = top->p_m.z();
       s_climb = s_hit;

@@ -99,10 +99,8 @@ class SupportQuery {
   // reaching unobserved terrain (open). Otherwise as probe_open. Without this, a stair's risers
   // close every probe at body height up the flight and the stairs never become a frontier (paper
   // III-C: stairs are the way to the next floor).
-  // `climbed` (optional): set when an open probe got there up at least one step.
   bool probe_open_climbing(const Eigen::Vector3f& foot, const Eigen::Vector2f& dir, float length_m,
-                           float height_m, float min_free_m, float min_unknown_m,
-                           bool* climbed = nullptr);
+                           float height_m, float min_free_m, float min_unknown_m);
 
   const map::MapView& view() const { return view_; }
   float voxel_size() const { return vs_; }

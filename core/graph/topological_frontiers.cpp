@@ -48,9 +48,7 @@ float TopologicalFrontiers::missing_surface_ratio(SupportQuery& q, const GraphNo
 // C_exp: probes at body height along directions not covered by an edge (within alpha_min / 2);
 // open if the probe crosses known free space and then reaches an unknown region (at least
 // probe_unknown_m of it) without hitting an obstacle first.
-int TopologicalFrontiers::open_directions(SupportQuery& q, const ReachableGraph& g, NodeId i,
-                                          int* up) {
-  if (up) *up = 0;
+int TopologicalFrontiers::open_directions(SupportQuery& q, const ReachableGraph& g, NodeId i) {
   const GraphNode& n = g.node(i);
   const int probes = std::max(1, opt_.probes);
   const float half = float(opt_.alpha_min_rad) * 0.5f;
@@ -66,12 +64,9 @@ int TopologicalFrontiers::open_directions(SupportQuery& q, const ReachableGraph&
       covered = std::abs(diff) < half;
     }
     if (covered) continue;
-    bool climbed = false;
-    const bool o = q.probe_open_climbing(n.p_m, Eigen::Vector2f(std::cos(th), std::sin(th)),
-                                         float(opt_.probe_length_m), float(opt_.probe_height_m),
-                                         min_free, float(opt_.probe_unknown_m), &climbed);
-    open += o;
-    if (up) *up += o && climbed;
+    open += q.probe_open_climbing(n.p_m, Eigen::Vector2f(std::cos(th), std::sin(th)),
+                                  float(opt_.probe_length_m), float(opt_.probe_height_m), min_free,
+                                  float(opt_.probe_unknown_m));
   }
   return open;
 }
@@ -131,17 +126,9 @@ void TopologicalFrontiers::evaluate_flags(ReachableGraph& g, SupportQuery& q, No
     n.c_sur = omega * 4 >= std::max(1, opt_.surface_samples) && n.rho >= float(opt_.rho_min);
   }
   if (opt_.use_c_exp) {
-    int up = 0;
-    const int open = open_directions(q, g, i, &up);
+    const int open = open_directions(q, g, i);
     n.open_dirs = uint8_t(std::min(open, 255));
-    // On a flight the way on is the one direction up the stairs: a node on the flight (it has a
-    // neighbour at least a step's half below) whose probe climbs on into unknown terrain leads
-    // the graph to the next floor. Nodes at the foot of a flight are not on it: standing there
-    // does not raise the sensor, the treads above stay unseen.
-    bool on_flight = false;
-    for (int e = 0; e < n.degree && !on_flight; ++e)
-      on_flight = g.node(g.edge(n.edges[e]).other(i)).p_m.z() < n.p_m.z() - 0.5f * q.step();
-    n.c_exp = open >= opt_.theta_min || (up > 0 && on_flight);
+    n.c_exp = open >= opt_.theta_min;
   }
 }
 

@@ -53,8 +53,7 @@ class TopologicalFrontiers {
 
  private:
   float missing_surface_ratio(SupportQuery& q, const GraphNode& n, int* samples);  // Eq. 5
-  // |Theta_open| of node i; `up` (optional): how many of them lead up a flight.
-  int open_directions(SupportQuery& q, const ReachableGraph& g, NodeId i, int* up = nullptr);
+  int open_directions(SupportQuery& q, const ReachableGraph& g, NodeId i);
   bool near_reach_boundary(SupportQuery& q, const GraphNode& n);
   void evaluate(ReachableGraph& g, SupportQuery& q, NodeId i);
   void evaluate_flags(ReachableGraph& g, SupportQuery& q, NodeId i);

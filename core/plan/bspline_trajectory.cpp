@@ -1,7 +1,5 @@
 #include "core/plan/bspline_trajectory.hpp"
 
-#include "core/plan/path_centring.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -190,24 +188,6 @@ TrajectoryResult TrajectoryBuilder::build(const map::MapView& view, CollisionChe
   std::vector<Eigen::Vector3d>& wp = r.waypoints_m;
   wp.push_back(path[0]);
   const size_t n = path.size();
-  // A shortcut never cuts across a flight or its run-up: skipped points must lie on the
-  // shortcut (the flight's axis, shape_flights) when it climbs a flight or ends at its foot; a
-  // diagonal onto a flight turns the body on a nosing, where it wedges against the next riser.
-  const double s_vox = view.voxel_size_m();
-  auto shortcut_ok = [&](size_t i, size_t j) {
-    const Eigen::Vector2d ab = (path[j] - path[i]).head<2>();
-    const double len = ab.norm();
-    bool climbs = false;
-    // (j itself at the foot of a flight: the run-up before it is kept too.)
-    for (size_t k = i; k < std::min(j + 1, n - 1) && !climbs; ++k)
-      climbs = flight_step(robot_, path[k], path[k + 1], s_vox);
-    for (size_t k = i + 1; climbs && k < j; ++k) {
-      const Eigen::Vector2d ap = (path[k] - path[i]).head<2>();
-      const double off = len > 1e-9 ? std::abs(ab.x() * ap.y() - ab.y() * ap.x()) / len : ap.norm();
-      if (off > 0.5 * s_vox) return false;
-    }
-    return segment_ok(view, checker, path[i], path[j]);
-  };
   size_t i = 0;
   while (i + 1 < n) {
     size_t good = i + 1;
@@ -215,7 +195,7 @@ TrajectoryResult TrajectoryBuilder::build(const map::MapView& view, CollisionChe
       size_t stepk = 1, bad = n;
       while (good + stepk < n) {
         ++r.segment_checks;
-        if (!shortcut_ok(i, good + stepk)) {
+        if (!segment_ok(view, checker, path[i], path[good + stepk])) {
           bad = good + stepk;
           break;
         }
@@ -224,7 +204,7 @@ TrajectoryResult TrajectoryBuilder::build(const map::MapView& view, CollisionChe
       }
       if (bad == n && good + 1 < n) {
         ++r.segment_checks;
-        if (shortcut_ok(i, n - 1))
+        if (segment_ok(view, checker, path[i], path[n - 1]))
           good = n - 1;
         else
           bad = n - 1;
@@ -232,7 +212,7 @@ TrajectoryResult TrajectoryBuilder::build(const map::MapView& view, CollisionChe
       while (bad - good > 1) {
         const size_t mid = good + (bad - good) / 2;
         ++r.segment_checks;
-        if (shortcut_ok(i, mid))
+        if (segment_ok(view, checker, path[i], path[mid]))
           good = mid;
         else
           bad = mid;

@@ -20,14 +20,18 @@ bool obstacle_at(const map::MapView& view, int32_t kx, int32_t ky, double h) {
   return false;
 }
 
-}  // namespace
-
+// A step between consecutive path points that climbs a flight (a rise over the step's half
+// height, steeper than 0.6 max_slope: stairs' mean grade is ~30 deg, ramps for legged robots
+// stay under ~15 deg). A ramp's points are centred and shaped like level ones, with the
+// ground following the ramp's grade.
 bool flight_step(const RobotModel& r, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                  double voxel_m) {
   const double dz = std::abs(b.z() - a.z());
   if (dz <= 0.5 * r.step_height_m) return false;
   return dz > std::tan(0.6 * r.max_slope_rad) * std::max((b - a).head<2>().norm(), voxel_m);
 }
+
+}  // namespace
 
 PathCentringStats centre_path(const map::MapView& view, std::vector<Eigen::Vector3d>& points,
                               const PathCentringOptions& opt) {
@@ -157,8 +161,7 @@ std::optional<FlightAxis> flight_axis(const map::MapView& view, const Eigen::Vec
   // axis of a straight flight).
   int best_k = -1;
   for (int k = 0; k < kDirs; ++k)
-    if ((hint.isZero() || dir_of(k).dot(hint) >= 0.5) && gains[k] > 0 &&
-        (best_k < 0 || gains[k] > gains[best_k]))
+    if (dir_of(k).dot(hint) >= 0.5 && gains[k] > 0 && (best_k < 0 || gains[k] > gains[best_k]))
       best_k = k;
   if (best_k < 0) return std::nullopt;
   const double best = gains[best_k];
@@ -208,9 +211,7 @@ FlightShaping shape_flights(const map::MapView& view, std::vector<Eigen::Vector3
   const double run_up = 0.5 * r.body_length_m + r.body_margin_m;
   const double half_w = 0.5 * r.body_width_m + r.body_margin_m;
   const double level = 0.5 * r.step_height_m;
-  // From j = 0: a robot standing at the foot of a flight (or on it) climbs on along the axis
-  // too; turning on a nosing wedges the body against the next riser.
-  for (size_t j = 0; j + 1 < points.size(); ++j) {
+  for (size_t j = 1; j + 1 < points.size(); ++j) {
     if (!flight_step(r, points[j], points[j + 1], s)) continue;
     const double sign = points[j + 1].z() > points[j].z() ? 1.0 : -1.0;
     // The flight's extent in the path: it ends where the path stays level for a run-up.
@@ -224,10 +225,12 @@ FlightShaping shape_flights(const map::MapView& view, std::vector<Eigen::Vector3
     }
     const bool ends_on_flight = e + 1 == points.size() && level_from + 1 >= e;
     const size_t end = std::min(level_from, points.size() - 1);
-    // A target one or two treads up gives no direction: any that climbs (the flight's own).
     Eigen::Vector2d hint = (points[end] - points[j]).head<2>();
-    hint = hint.norm() < 0.2 ? Eigen::Vector2d::Zero() : Eigen::Vector2d(hint.normalized());
-    const auto axis = flight_axis(view, points[j], hint, sign);
+    if (hint.norm() < 0.2) {
+      j = e;
+      continue;
+    }
+    const auto axis = flight_axis(view, points[j], hint.normalized(), sign);
     if (!axis) {
       ++out.no_axis;
       j = e;
@@ -241,12 +244,8 @@ FlightShaping shape_flights(const map::MapView& view, std::vector<Eigen::Vector3
     const Eigen::Vector2d ru2 = foot2 - run_up * axis->dir;
     const auto ru_sp = view.support_surface_near(
         Eigen::Vector3f(float(ru2.x()), float(ru2.y()), float(points[j].z())), level);
-    const bool run_up_ok = ru_sp &&
-                           (ru_sp->reachable || ru_sp->state == map::TravState::kTraversable) &&
-                           clear_disc(view, ru2, ru_sp->height_m, half_w);
-    // Without room for a run-up only a robot already at the flight (the path's start) goes on:
-    // straight onto the axis from where it stands.
-    if (!run_up_ok && j > 0) {
+    if (!ru_sp || !(ru_sp->reachable || ru_sp->state == map::TravState::kTraversable) ||
+        !clear_disc(view, ru2, ru_sp->height_m, half_w)) {
       ++out.no_run_up;
       j = e;
       continue;
@@ -254,10 +253,7 @@ FlightShaping shape_flights(const map::MapView& view, std::vector<Eigen::Vector3
     // The flight's points along the axis, from the foot to the projection of its last point.
     const double s_end = (points[end].head<2>() - foot2).dot(axis->dir);
     std::vector<Eigen::Vector3d> line;
-    if (run_up_ok)
-      line.emplace_back(ru2.x(), ru2.y(), ru_sp->height_m);
-    else
-      line.emplace_back(foot2.x(), foot2.y(), points[j].z());
+    line.emplace_back(ru2.x(), ru2.y(), ru_sp->height_m);
     const int n = std::max(1, int(std::ceil(s_end / s)));
     double z_prev = points[j].z();
     for (int i = 0; i <= n; ++i) {
@@ -274,7 +270,7 @@ FlightShaping shape_flights(const map::MapView& view, std::vector<Eigen::Vector3
       z_prev = z;
     }
     // Replace the approach within a run-up of the foot, the flight, and its last point.
-    size_t first = std::max<size_t>(j, 1);  // the path's start (the robot) stays
+    size_t first = j;
     while (first > 1 && (points[first - 1] - points[j]).head<2>().norm() < run_up) --first;
     points.erase(points.begin() + long(first), points.begin() + long(end) + 1);
     points.insert(points.begin() + long(first), line.begin(), line.end());

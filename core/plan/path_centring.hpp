@@ -35,20 +35,13 @@ PathCentringStats centre_path(const map::MapView& view, std::vector<Eigen::Vecto
                               const PathCentringOptions& opt = {});
 
 // A stair flight's axis: the line the body should walk, origin on it near the flight's foot.
-// A step between consecutive path points that climbs a flight: a rise over half the step
-// height, steeper than 0.6 max_slope (stairs' mean grade is ~30 deg; ramps for legged robots stay
-// under ~15 deg and are centred and shaped like level ground, along their grade).
-bool flight_step(const RobotModel& r, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                 double voxel_m);
-
 struct FlightAxis {
   Eigen::Vector2d origin = Eigen::Vector2d::Zero();
   Eigen::Vector2d dir = Eigen::Vector2d::UnitX();  // unit, direction of travel
   double width_m = INFINITY;                       // between the side walls (inf: open side)
 };
 // The axis of the flight whose foot is `foot` (support point), travelled within 60 deg of
-// `hint` (unit; zero: any direction), rising (sign +1) or falling (-1): from the support heights
-// the map holds ahead.
+// `hint` (unit), rising (sign +1) or falling (-1): from the support heights the map holds ahead.
 std::optional<FlightAxis> flight_axis(const map::MapView& view, const Eigen::Vector3d& foot,
                                       const Eigen::Vector2d& hint, double sign);
 
