@@ -156,12 +156,9 @@ TravState TraversabilityMap::evaluate(const VoxelKey& k, VoxelStats* s) {
 
   // R_col(v): an occupied voxel whose points lie above the step height and below the body
   // clearance, within collision_radius_m of v's column.
-  // The height v's body would stand at: the top of v's points, estimated as mean + one standard
-  // deviation in z (within the voxel). At a stair's nosing the voxel also holds riser points
-  // below the tread, which pull the mean down; against the mean, the next tread (one 0.167 m
-  // rise up) would read higher than the 0.18 m step and block every nosing.
-  const double var_z = s->count ? std::max(0.0, double(s->m2[5]) / double(s->count)) : 0.0;
-  const double h_top = std::min(double(h_v) + std::sqrt(var_z), (double(k.z) + 1.0) * vs);
+  // The height v's body would stand at (standing_height): against the mean, the next tread
+  // (one 0.167 m rise up) would read higher than the 0.18 m step and block every nosing.
+  const double h_top = standing_height(k, s);
   const double clear = robot_.body_height_m + robot_.body_margin_m;
   const int rc2 = r_col_ * r_col_;
   for (int dx = -r_col_; dx <= r_col_ && !(s->reasons & VoxelStats::kReasonCollision); ++dx)
@@ -187,6 +184,9 @@ TravState TraversabilityMap::evaluate(const VoxelKey& k, VoxelStats* s) {
   // below v's level is observed free (v's own level is not evidence: rays graze through the
   // upper part of floor voxels). Unknown columns are no evidence either way (under-observed
   // ground is S_unobs territory, not a ledge). Too many drops in the neighbourhood: a ledge.
+  // Heights compared where the feet stand (standing_height): at a nosing, mean heights pulled
+  // down by riser points read a 0.167 m rise as a drop beyond the 0.18 m step.
+  const float h_stand = float(h_top);
   int total = 0, drops = 0;
   for (int dx = -r_agg_; dx <= r_agg_; ++dx)
     for (int dy = -r_agg_; dy <= r_agg_; ++dy) {
@@ -202,7 +202,7 @@ TravState TraversabilityMap::evaluate(const VoxelKey& k, VoxelStats* s) {
           continue;
         }
         const double dh =
-            surface_height(w, cw->stats == Cell::kNoStats ? nullptr : reader_.stats(w)) - h_v;
+            standing_height(w, cw->stats == Cell::kNoStats ? nullptr : reader_.stats(w)) - h_stand;
         safe = dh >= -robot_.step_height_m && dh <= clear;
       }
       drops += !safe && seen_free;

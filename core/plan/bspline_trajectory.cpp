@@ -56,11 +56,16 @@ TrajectorySample BsplineTrajectory::sample(double t) const {
   s.v_mps /= dt_;
   s.a_mps2 /= dt_ * dt_;
   s.yaw_rate_rps = yaw_rate_u / dt_;
-  // Pitch of the terrain along the heading: from the velocity, or the local chord at rest.
+  // Pitch of the terrain along the heading: from the velocity, or the local chord when slow.
+  // Slow (turning in place, starting) the ratio of two small numbers is noise: a centimetre of
+  // surface noise over a millimetre of travel tilts the box by tens of degrees into the next
+  // step. Below half a voxel of chord, level (CollisionChecker::terrain_pitch reads the map).
+  // (The same 0.05 bound serves both: m/s of velocity, m of chord.)
+  constexpr double kMin = 0.05;
   Eigen::Vector3d dir = s.v_mps;
-  if (dir.head<2>().norm() < 1e-3) dir = ctrl_[i + 3] - ctrl_[i];
+  if (dir.head<2>().norm() < kMin) dir = ctrl_[i + 3] - ctrl_[i];
   const double len = dir.head<2>().norm();
-  if (len > 1e-6) {
+  if (len >= kMin) {
     const double fwd = dir.x() * std::cos(s.yaw_rad) + dir.y() * std::sin(s.yaw_rad);
     s.pitch_rad = std::atan2(fwd >= 0 ? dir.z() : -dir.z(), len);
   }

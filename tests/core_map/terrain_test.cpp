@@ -129,6 +129,34 @@ TEST(Terrain, Stairs17cmAreTraversableAndReachable) {
   EXPECT_GE(land.reach, land.samples * 90 / 100) << land.str();
 }
 
+// A building's stair (0.167 m rise, 1 cm under the 0.18 m step): nosing voxels hold riser
+// points below the tread, which pull their mean height down; against the mean, the tread below
+// reads as a drop beyond the step and every nosing as a ledge. Heights compared where the feet
+// stand (standing_height) keep the whole tread free of fall risk.
+TEST(Terrain, NosingsOfA167mmStairAreNoLedge) {
+  World w = floor_world(8.f);
+  const float rise = 0.1667f, tread = 0.29f;
+  const int n = 6;
+  w.stairs(1.0f, -0.7f, 0.7f, 0.03f, n, rise, tread);
+  w.add(aabb({1.0f + n * tread, -0.7f, -0.3f}, {1.0f + n * tread + 2.0f, 0.7f, 0.03f + n * rise}));
+  TraversabilityMap m;
+  // Seen as the robot climbing it sees it: from the foot and from the treads at body height.
+  std::vector<Vector3f> origins = {{0.3f, 0, 0.45f}};
+  for (int i = 0; i < n; ++i)
+    origins.emplace_back(1.0f + (i + 0.5f) * tread, 0, 0.45f + (i + 1) * rise);
+  survey(m, w, origins, Vector3f(0, 0, 0.03f));
+  int fall = 0, found = 0;
+  for (int i = 0; i < n; ++i) {
+    const float h = 0.03f + (i + 1) * rise;
+    const Tally t = tally(m, 1.0f + i * tread, 1.0f + (i + 1) * tread, -0.4f, 0.4f,
+                          [h](float, float) { return h; });
+    fall += t.fall;
+    found += t.found;
+  }
+  EXPECT_GT(found, 100);
+  EXPECT_EQ(fall, 0) << "tread voxels flagged R_fall";
+}
+
 TEST(Terrain, Slope45DegIsNotTraversable) {
   World w = floor_world(8.f);
   const float a = 45 * kDeg;

@@ -89,6 +89,25 @@ TEST(BsplineTrajectory, LimitsAndEndpointsOnRandomPolylines) {
   }
 }
 
+// Turning in place: the control points differ by a millimetre in x and a centimetre of surface
+// noise in z. The body's pitch stays level (it was atan(10 / 1) = 84 deg, which put the box into
+// the next stair riser in the look-ahead).
+TEST(BsplineTrajectory, TurningInPlaceKeepsTheBodyLevel) {
+  std::vector<Eigen::Vector3d> c;
+  std::vector<double> y;
+  for (int k = 0; k < 8; ++k) {
+    c.emplace_back(0.001 * k, 0.0, 0.01 * (k % 2));
+    y.push_back(0.4 * k);
+  }
+  const BsplineTrajectory t(c, y, 0.5, 0.0);
+  for (double s = t.t_start(); s <= t.t_end(); s += 0.05) EXPECT_EQ(t.pose(s).pitch_rad, 0.0) << s;
+  // Walking up a 10 deg ramp still reads its pitch.
+  std::vector<Eigen::Vector3d> r;
+  for (int k = 0; k < 8; ++k) r.emplace_back(0.2 * k, 0.0, 0.2 * k * std::tan(10 * M_PI / 180));
+  const BsplineTrajectory u(r, std::vector<double>(8, 0.0), 0.5, 0.0);
+  EXPECT_NEAR(u.pose(0.5 * (u.t_start() + u.t_end())).pitch_rad, 10 * M_PI / 180, 1e-6);
+}
+
 TEST(BsplineTrajectory, BadInput) {
   map::TraversabilityMap empty;
   CollisionChecker cc(RobotModel{}, 0.1);
