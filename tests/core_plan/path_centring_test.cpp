@@ -63,6 +63,33 @@ TEST(PathCentring, MovesPointsInADoorToItsMiddle) {
     }
 }
 
+// A 10 deg ramp, 1.5 m wide between side walls, and a sparse path along G_real (nodes 1 m
+// apart, 0.18 m of rise between them) 0.25 m from the left wall. The ramp's points are centred
+// like level ground; before, the rise between them read as a flight and they stayed at the wall.
+TEST(PathCentring, RampPointsAreCentredAlongTheGrade) {
+  const float a = float(10 * M_PI / 180);
+  storey::test::World w;
+  w.add(aabb({-4, -3, -0.2f}, {0.05f, 3, 0}));
+  w.add(storey::test::ramp(0.0f, -0.75f, 0.75f, 0.0f, 6.0f, a));
+  w.add(aabb({0, -0.87f, -0.2f}, {6, -0.75f, 3.0f}));
+  w.add(aabb({0, 0.75f, -0.2f}, {6, 0.87f, 3.0f}));
+  map::TraversabilityMap m;
+  std::vector<Eigen::Vector3f> origins;
+  for (float x = -1.0f; x <= 5.0f; x += 1.0f)
+    origins.emplace_back(x, 0.0f, std::max(0.0f, x) * std::tan(a) + 0.5f);
+  storey::test::scan_world(m, w, origins);
+  const map::MapView view = m.view();
+  std::vector<Vector3d> path;
+  for (int x = -1; x <= 5; ++x) path.emplace_back(x, 0.5, std::max(0, x) * std::tan(double(a)));
+  const std::vector<Vector3d> before = path;
+  const PathCentringStats st = centre_path(view, path);
+  EXPECT_GT(st.moved, 0);
+  for (size_t i = 2; i + 2 < path.size(); ++i) {  // on the ramp, away from its ends
+    EXPECT_LT(path[i].y(), 0.4) << i << ": " << path[i].transpose();
+    EXPECT_NEAR(path[i].z(), before[i].z(), 0.1) << i;  // still on the ramp's surface
+  }
+}
+
 TEST(PathCentring, FlightIsWalkedOnItsAxisAfterARunUp) {
   map::TraversabilityMap m;
   storey::test::scan_world(m, stair_world(),
