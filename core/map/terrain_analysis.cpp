@@ -184,9 +184,8 @@ TravState TraversabilityMap::evaluate(const VoxelKey& k, VoxelStats* s) {
   // below v's level is observed free (v's own level is not evidence: rays graze through the
   // upper part of floor voxels). Unknown columns are no evidence either way (under-observed
   // ground is S_unobs territory, not a ledge). Too many drops in the neighbourhood: a ledge.
-  // Heights compared where the feet stand (standing_height): at a nosing, mean heights pulled
-  // down by riser points read a 0.167 m rise as a drop beyond the 0.18 m step.
-  const float h_stand = float(h_top);
+  // Heights compared where the feet stand (standing_height, h_top): at a nosing, mean heights
+  // pulled down by riser points read a 0.167 m rise as a drop beyond the 0.18 m step.
   int total = 0, drops = 0;
   for (int dx = -r_agg_; dx <= r_agg_; ++dx)
     for (int dy = -r_agg_; dy <= r_agg_; ++dy) {
@@ -202,7 +201,7 @@ TravState TraversabilityMap::evaluate(const VoxelKey& k, VoxelStats* s) {
           continue;
         }
         const double dh =
-            standing_height(w, cw->stats == Cell::kNoStats ? nullptr : reader_.stats(w)) - h_stand;
+            standing_height(w, cw->stats == Cell::kNoStats ? nullptr : reader_.stats(w)) - h_top;
         safe = dh >= -robot_.step_height_m && dh <= clear;
       }
       drops += !safe && seen_free;

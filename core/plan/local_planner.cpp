@@ -223,7 +223,7 @@ bool LocalPlanner::escape(const LocalPlanInput& in, LocalPlanResult& out) {
 bool LocalPlanner::try_target(const LocalPlanInput& in, const Viewpoint& vp, LocalPlanResult& out,
                               SetAsideReason* why) {
   *why = SetAsideReason::kAstarFailed;
-  last_hit_m_ = kNoHit;
+  last_hit_m_ = kNoHitM;
   ++out.astar_calls;
   VoxelPath path = astar_.plan(*in.view, start_foot_m_, vp.p_m);
   // The ground under the feet may be in the LiDAR's blind ring (start-up): search from the

@@ -87,6 +87,10 @@ enum class SetAsideReason : uint8_t {
 };
 const char* to_string(SetAsideReason r);
 
+// "No collision point": NaN (SetAsideEntry::hit_m and LocalPlanner's last Stage 3 hit).
+inline const Eigen::Vector3f kNoHitM =
+    Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
+
 struct SetAsideEntry {
   Eigen::Vector3f p_m = Eigen::Vector3f::Zero();  // frontier node position when set aside
   double t_s = 0;                                 // when
@@ -95,7 +99,7 @@ struct SetAsideEntry {
   Eigen::Vector3f robot_m = Eigen::Vector3f::Zero();  // robot foot point then
   uint16_t frontier_sig = 0;  // the node's frontier flags then (frontier_signature())
   // kTrajectoryFailed: a voxel the body hit on the last try (NaN otherwise): diagnostics.
-  Eigen::Vector3f hit_m = Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
+  Eigen::Vector3f hit_m = kNoHitM;
 };
 // C_sur, C_exp, boundary and |Theta_open| of a node packed: what TopologicalFrontiers
 // recomputes when the map near the node changes.
@@ -138,9 +142,7 @@ class LocalPlanner {
   };
   bool ignored(const Eigen::Vector3f& p) const { return set_aside_at(p) != nullptr; }
   void set_aside_cluster(const LocalPlanInput& in, const graph::FrontierCluster& c,
-                         SetAsideReason reason, const Eigen::Vector3f& hit_m = kNoHit);
-  static inline const Eigen::Vector3f kNoHit =
-      Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
+                         SetAsideReason reason, const Eigen::Vector3f& hit_m = kNoHitM);
   int expire_set_aside(const LocalPlanInput& in);
   const graph::FrontierCluster* find_cluster(const LocalPlanInput& in, int32_t id) const;
   void build_search_graph(const graph::ReachableGraph& g);
@@ -180,7 +182,7 @@ class LocalPlanner {
   uint64_t expired_total_ = 0;
   std::vector<graph::NodeId> near_scratch_;
   std::vector<std::pair<int32_t, int>> failures_;
-  Eigen::Vector3f last_hit_m_ = kNoHit;  // try_target: where the last B-spline collided
+  Eigen::Vector3f last_hit_m_ = kNoHitM;  // try_target: where the last B-spline collided
   std::vector<int32_t>
       approached_;  // clusters whose viewpoint was reached once (walk onto them next)
 };
