@@ -1,6 +1,7 @@
 // LiDAR models, robot model and the lockstep WorldSim (tools/sim).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -147,6 +148,31 @@ TEST(SimRobot, ClimbsStairsThenStopsAtWallRecordingCollision) {
   EXPECT_GT(robot.state().position.x(), 7.8 - 0.35 - 0.05);
   EXPECT_TRUE(robot.state().stuck);  // commanded, no progress for 2 s
   EXPECT_EQ(robot.state().falls, 0u);
+}
+
+// A trunk follows the mean plane under its feet: a climb with the body yawed off the flight's
+// axis (walking along the axis) stays clear of the nosings. With pitch and roll from four edge
+// probes the attitude jumped by a full riser as a probe crossed a nosing (roll 28 deg), and a
+// 2 deg skew wedged the body at the first riser.
+TEST(SimRobot, ClimbsStairsWithTheBodySkewedOffTheAxis) {
+  const sim::Scene s = sim::load_scene("test_stair");
+  const sim::RayCaster rc(s.mesh);
+  for (double deg : {-10.0, -4.0, 2.0, 6.0, 10.0}) {
+    const double a = deg * M_PI / 180.0;
+    sim::RobotModel robot(rc, {1.2, 1.2, 0.0, a});
+    double max_roll = 0.0;
+    for (int i = 0; i < 2000 && robot.state().position.x() < 6.5; ++i) {
+      robot.step(0.01, {0.5 * std::cos(a), -0.5 * std::sin(a), 0});  // along +x in the world
+      max_roll = std::max(max_roll, std::abs(robot.state().roll));
+    }
+    EXPECT_EQ(robot.state().collisions, 0u) << deg << " deg";
+    EXPECT_GT(robot.state().position.z(), 2.5) << deg << " deg";
+    EXPECT_LT(max_roll, 0.2) << deg << " deg";  // [rad]: no full-riser roll
+  }
+  // Mid-flight the trunk is pitched like the flight (0.1667 / 0.29: 29.9 deg), within 5 deg.
+  sim::RobotModel robot(rc, {1.2, 1.2, 0.0, 0.0});
+  for (int i = 0; i < 2000 && robot.state().position.x() < 4.0; ++i) robot.step(0.01, {0.5, 0, 0});
+  EXPECT_NEAR(-robot.state().pitch, std::atan(0.1667 / 0.29), 5.0 * M_PI / 180.0);
 }
 
 TEST(SimRobot, CannotClimbABoxAndDrivesUnderATable) {

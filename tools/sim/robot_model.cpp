@@ -52,20 +52,35 @@ RobotModel::Probe RobotModel::probe(double x, double y, double z_ref) const {
   return p;
 }
 
+// A legged trunk follows the mean plane of the ground under its feet, not the ground under four
+// points: pitch and roll come from a least-squares plane z = a + b x + c y (body-yaw frame)
+// through probes on a 9 x 3 grid under the footprint. Four edge probes made the attitude jump by
+// a full riser whenever one crossed a stair nosing (15 <-> 29 deg pitch on a 0.29 m run, 28 deg
+// roll when one side probe was a tread ahead), which wedged any slightly skewed climb.
 void RobotModel::attitude(double x, double y, double yaw, double z, double* pitch,
                           double* roll) const {
   const double c = std::cos(yaw), s = std::sin(yaw);
   const double hx = opt_.length / 2 - 0.05, hy = opt_.width / 2;
   const double reach = opt_.step_height + hx * std::tan(opt_.max_slope_deg * M_PI / 180.0);
-  auto h = [&](double bx, double by, double* out) {
-    const Probe p = probe(x + c * bx - s * by, y + s * bx + c * by, z);
-    if (!p.hit || std::abs(p.z - z) > reach) return false;
-    *out = p.z;
-    return true;
-  };
-  double f, b, l, r;
-  *pitch = (h(hx, 0, &f) && h(-hx, 0, &b)) ? -std::atan2(f - b, 2 * hx) : 0.0;
-  *roll = (h(0, hy, &l) && h(0, -hy, &r)) ? std::atan2(l - r, 2 * hy) : 0.0;
+  constexpr int kNx = 9, kNy = 3;
+  Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d r = Eigen::Vector3d::Zero();
+  int n = 0;
+  for (int i = 0; i < kNx; ++i)
+    for (int j = 0; j < kNy; ++j) {
+      const double bx = -hx + 2 * hx * i / (kNx - 1), by = -hy + 2 * hy * j / (kNy - 1);
+      const Probe p = probe(x + c * bx - s * by, y + s * bx + c * by, z);
+      if (!p.hit || std::abs(p.z - z) > reach) continue;
+      const Eigen::Vector3d row(1.0, bx, by);
+      A += row * row.transpose();
+      r += row * (p.z - z);
+      ++n;
+    }
+  *pitch = 0.0, *roll = 0.0;
+  if (n < 3 || std::abs(A.determinant()) < 1e-9) return;  // too little support seen: level
+  const Eigen::Vector3d abc = A.ldlt().solve(r);
+  *pitch = -std::atan(abc.y());
+  *roll = std::atan(abc.z());
 }
 
 // Segments through the body box between step height (+2 cm) and the body top: its four edges,

@@ -79,7 +79,7 @@ class RobotModel {
   };
   Probe probe(double x, double y, double z_ref) const;
   void physics_step(const VelocityCommand& cmd);
-  // Pitch/roll from the support under the box edges (kept when probes miss).
+  // Pitch/roll of the mean support plane under the footprint (level when too little is seen).
   void attitude(double x, double y, double yaw, double z, double* pitch, double* roll) const;
   bool body_collides(const Eigen::Isometry3d& body) const;
 
