@@ -154,6 +154,8 @@ void read_plan(SectionReader&& r, core::plan::PlanOptions& o) {
   r.get("traj_max_repairs", o.traj_max_repairs, Range{0, 1000});
   r.get("lookahead_s", o.lookahead_s, Range{0.1, 10.0});
   r.get("floor_stable_s", o.floor_stable_s, Range{0.0, 60.0});
+  r.get("floor_stable_band_m", o.floor_stable_band_m, Range{0.01, 1.0});
+  r.get("floor_stable_travel_m", o.floor_stable_travel_m, Range{0.0, 20.0});
   r.get("floor_node_band_m", o.floor_node_band_m, Range{0.05, 5.0});
   r.get("zone_clearance_radius_m", o.zone_clearance_radius_m, Range{0.1, 50.0});
   r.get("hyp_height_window_m", o.hyp_height_window_m, Range{0.01, 5.0});

@@ -58,6 +58,8 @@ FloorTrackerOptions floor_options(const PlanOptions& o) {
   FloorTrackerOptions f;
   f.floor_change_dz_m = o.floor_change_dz_m;
   f.stable_s = o.floor_stable_s;
+  f.stable_band_m = o.floor_stable_band_m;
+  f.stable_travel_m = o.floor_stable_travel_m;
   f.node_band_m = o.floor_node_band_m;
   return f;
 }
@@ -167,7 +169,7 @@ ExplorationResult ExplorationPlanner::plan_cycle(const ExplorationInput& in) {
   }
   const graph::ReachableGraph& g = *in.graph;
   // 1) Floors.
-  r.floor_changed = floors_.update(in.robot_foot_m.z(), in.t_s);
+  r.floor_changed = floors_.update(in.robot_foot_m, in.t_s);
   update_floor_progress(g);
   r.floor = floors_.current();
   // 2) Prior on arrival on a new floor (Sec. IV-A).

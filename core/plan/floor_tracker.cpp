@@ -5,8 +5,9 @@
 
 namespace storey::core::plan {
 
-bool FloorTracker::update(double z, double t) {
-  if (!std::isfinite(z) || !std::isfinite(t)) {
+bool FloorTracker::update(const Eigen::Vector3d& foot, double t) {
+  const double z = foot.z();
+  if (!foot.allFinite() || !std::isfinite(t)) {
     ++bad_input_;
     return false;
   }
@@ -25,9 +26,11 @@ bool FloorTracker::update(double z, double t) {
     candidate_ = true;  // still moving (stairs, ramp): restart the stability window
     cand_z_ = z;
     cand_since_ = t;
+    cand_xy_ = foot.head<2>();
     return false;
   }
   if (t - cand_since_ < opt_.stable_s) return false;
+  if ((foot.head<2>() - cand_xy_).norm() < opt_.stable_travel_m) return false;
   candidate_ = false;
   int32_t best = -1;
   for (const Floor& f : floors_)

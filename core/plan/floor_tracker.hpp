@@ -4,14 +4,18 @@
 //
 // Floor change: the robot's support height leaves the current floor by more than
 // floor_change_dz_m (a stair or ramp transition) and then stays within stable_band_m of one
-// height for stable_s; the robot is then on the known floor within floor_change_dz_m / 2 of
-// that height, or on a new floor. Heights between floors (stairs, ramps) never start a floor:
-// they do not stay put for stable_s.
+// height for stable_s while it walks stable_travel_m away (horizontally) from where it came
+// within that band; the robot is then on the known floor within floor_change_dz_m / 2 of that
+// height, or on a new floor. Heights between floors never start a floor: on stairs the height
+// does not stay put, and on a ramp it cannot stay in the band over stable_travel_m (slopes
+// steeper than atan(stable_band_m / stable_travel_m), 4.6 deg by default), even where the robot
+// stands still mid-ramp for a while (it used to start a floor there).
 // Nodes are labelled by the floor whose height is nearest their support height, within
 // node_band_m (else -1: stairs, ramps, unknown floors). A floor's height is refined from its
 // nodes: the mode of their support heights (histogram of mode_bin_m), mean of that bin.
 // dz(ref, target) = difference of the two modes. The reference floor for a target floor is the
 // most completely explored adjacent floor (nearest below or above).
+#include <Eigen/Core>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -21,7 +25,8 @@ namespace storey::core::plan {
 struct FloorTrackerOptions {
   double floor_change_dz_m = 1.5;  // support height change that means another floor
   double stable_s = 2.0;           // the new height must hold this long
-  double stable_band_m = 0.3;      // ... within this band
+  double stable_band_m = 0.12;     // ... within this band
+  double stable_travel_m = 1.5;    // ... while the robot walks this far (horizontal) in it
   double node_band_m = 0.6;        // nodes within this of a floor's height belong to it
   double mode_bin_m = 0.1;         // histogram bin of the height mode
   int min_mode_nodes = 10;         // fewer nodes: keep the robot-derived height
@@ -42,7 +47,7 @@ class FloorTracker {
 
   // One planning cycle. Returns true if the robot's floor changed in this call (the first call
   // creates floor 0 and returns true). Non-finite input is ignored (counted).
-  bool update(double foot_z_m, double t_s);
+  bool update(const Eigen::Vector3d& foot_m, double t_s);
   int32_t current() const { return current_; }
   const std::vector<Floor>& floors() const { return floors_; }
   Floor& floor(int32_t id) { return floors_[size_t(id)]; }
@@ -69,6 +74,7 @@ class FloorTracker {
   bool changed_to_new_ = false;
   bool candidate_ = false;
   double cand_z_ = 0, cand_since_ = 0;
+  Eigen::Vector2d cand_xy_ = Eigen::Vector2d::Zero();
   uint32_t bad_input_ = 0;
   std::vector<int> hist_;
 };

@@ -64,8 +64,8 @@ TEST(ExplorationPlanner, FloorChangeBuildsThePriorOnlyWithUsePrior) {
       changed = changed || planner.plan(input(h, view, foot, t)).floor_changed;
     }
     EXPECT_FALSE(changed) << "a floor change during the climb";
-    for (int i = 0; i < 8; ++i, t += 0.5) {
-      const Eigen::Vector3f foot(8, 2, 2.89f);
+    for (int i = 0; i < 8; ++i, t += 0.5) {  // walking on (a floor needs 1.5 m of level travel)
+      const Eigen::Vector3f foot(8 + 0.3f * float(i), 2, 2.89f);
       h.observe(w, foot, 20000, 100 + uint32_t(i));
       const auto view = h.map.view();
       const ExplorationResult r = planner.plan(input(h, view, foot, t));
@@ -135,7 +135,7 @@ TEST(GlobalPlanner, VisitsTheNearerHypotheticalZoneFirst) {
   const Eigen::Vector3f foot(2, 2.5f, 0);
   h.observe(w, foot, 20000, 5);
   FloorTracker ft;
-  ft.update(0, 0);
+  ft.update(Eigen::Vector3d::Zero(), 0.0);
   HybridGraph hg;
   hg.init_prior(g, zones, 0.0, 0);
   PlanOptions opt;

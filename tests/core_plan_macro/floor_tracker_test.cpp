@@ -9,21 +9,29 @@
 using namespace storey::core::plan;
 
 namespace {
-// Robot climbing 17 steps of 0.17 m (one step per 0.5 s), starting at t0.
-double stairs_z(double t, double t0) {
+// Robot climbing 17 steps of 0.17 m (one step per 0.5 s), starting at t0, walking on at
+// 0.5 m/s along x.
+Eigen::Vector3d stairs(double t, double t0) {
   const int steps = std::clamp(int((t - t0) / 0.5), 0, 17);
-  return 0.17 * steps;
+  return {0.5 * t, 0.0, 0.17 * steps};
+}
+// A robot standing at height z (x = 0) or walking at 0.5 m/s from x = 0 at t0.
+Eigen::Vector3d at(double z) {
+  return {0.0, 0.0, z};
+}
+Eigen::Vector3d walking(double z, double t, double t0) {
+  return {0.5 * (t - t0), 0.0, z};
 }
 }  // namespace
 
 TEST(FloorTracker, DetectsTheNextFloorAfterTheStairsOnceStable) {
   FloorTracker ft;
-  EXPECT_TRUE(ft.update(0.0, 0.0));
+  EXPECT_TRUE(ft.update(at(0.0), 0.0));
   EXPECT_EQ(ft.current(), 0);
   bool changed = false;
   double changed_at = -1;
   for (double t = 0.1; t < 20.0; t += 0.1) {
-    const bool c = ft.update(stairs_z(t, 1.0), t);
+    const bool c = ft.update(stairs(t, 1.0), t);
     if (c && !changed) changed_at = t;
     changed = changed || c;
   }
@@ -31,21 +39,22 @@ TEST(FloorTracker, DetectsTheNextFloorAfterTheStairsOnceStable) {
   EXPECT_EQ(ft.current(), 1);
   EXPECT_TRUE(ft.is_new_floor());
   EXPECT_EQ(ft.floors().size(), 2u);
-  // On the landing (z = 2.89 from t = 9.5) for stable_s = 2 s, not during the climb.
-  EXPECT_GE(changed_at, 9.5 + 2.0 - 1e-9);
-  EXPECT_LT(changed_at, 9.5 + 2.0 + 0.5);
+  // On the landing (z = 2.89 from t = 9.5) after 1.5 m of walking (3 s > stable_s = 2 s), not
+  // during the climb.
+  EXPECT_GE(changed_at, 9.5 + 3.0 - 1e-9);
+  EXPECT_LT(changed_at, 9.5 + 3.0 + 0.2);
   EXPECT_NEAR(ft.floor(1).z_m, 2.89, 1e-9);
 }
 
 TEST(FloorTracker, HeightsOnTheStairsNeverMakeAFloorAndGoingBackFindsTheOldOne) {
   FloorTracker ft;
-  ft.update(0.0, 0.0);
+  ft.update(at(0.0), 0.0);
   // Up and down a long slow ramp: never stable beyond the band.
   double t = 0;
-  for (; t < 30; t += 0.1) ft.update(0.1 * t, t);  // 0 .. 3 m, 0.1 m/s
-  for (int i = 0; i < 40; ++i, t += 0.1) ft.update(3.0, t);
+  for (; t < 30; t += 0.1) ft.update(at(0.1 * t), t);  // 0 .. 3 m, 0.1 m/s
+  for (int i = 0; i < 40; ++i, t += 0.1) ft.update(walking(3.0, t, 30.0), t);
   ASSERT_EQ(ft.current(), 1);
-  for (int i = 0; i < 40; ++i, t += 0.1) ft.update(0.05, t);
+  for (int i = 0; i < 40; ++i, t += 0.1) ft.update(walking(0.05, t, 34.0), t);
   EXPECT_EQ(ft.current(), 0);
   EXPECT_FALSE(ft.is_new_floor());
   EXPECT_EQ(ft.floors().size(), 2u);
@@ -53,8 +62,8 @@ TEST(FloorTracker, HeightsOnTheStairsNeverMakeAFloorAndGoingBackFindsTheOldOne) 
 
 TEST(FloorTracker, NodeLabelsDzFromModesAndReferenceFloor) {
   FloorTracker ft;
-  ft.update(0.02, 0.0);
-  for (int i = 0; i < 30; ++i) ft.update(3.1, 1.0 + 0.1 * i);
+  ft.update(at(0.02), 0.0);
+  for (int i = 0; i < 40; ++i) ft.update(walking(3.1, 0.1 * i, 0.0), 1.0 + 0.1 * i);
   ASSERT_EQ(ft.current(), 1);
   std::vector<float> z;
   for (int i = 0; i < 50; ++i) z.push_back(0.0f + 0.01f * float(i % 3));  // floor 0 at ~0.01
@@ -70,7 +79,7 @@ TEST(FloorTracker, NodeLabelsDzFromModesAndReferenceFloor) {
   EXPECT_EQ(ft.choose_reference(1), 0);
   EXPECT_EQ(ft.choose_reference(0), 1);
   // A third floor above: floor 1 (adjacent) is the reference, never floor 0.
-  for (int i = 0; i < 30; ++i) ft.update(6.0, 5.0 + 0.1 * i);
+  for (int i = 0; i < 40; ++i) ft.update(walking(6.0, 0.1 * i, 0.0), 5.0 + 0.1 * i);
   ASSERT_EQ(ft.current(), 2);
   ft.floor(0).explored = true;
   EXPECT_EQ(ft.choose_reference(2), 1);
@@ -82,7 +91,40 @@ TEST(FloorTracker, NodeLabelsDzFromModesAndReferenceFloor) {
 
 TEST(FloorTracker, NonFiniteInputIsCountedAndIgnored) {
   FloorTracker ft;
-  EXPECT_FALSE(ft.update(std::nan(""), 0.0));
-  EXPECT_EQ(ft.bad_input(), 1u);
+  EXPECT_FALSE(ft.update(at(std::nan("")), 0.0));
+  EXPECT_FALSE(ft.update({std::nan(""), 0.0, 0.0}, 0.0));
+  EXPECT_EQ(ft.bad_input(), 2u);
+  EXPECT_TRUE(ft.update(at(0.0), std::nan("")) == false);
   EXPECT_EQ(ft.current(), -1);
+}
+
+// Maze's long 5 deg and test_ramp's 10 deg ramps: the robot stops mid-ramp for 10 s (a replan, a
+// safety stop) and walks on. That never starts a floor; the floor at the top does, once the
+// robot has walked 1.5 m on it. (With the height alone, the pause made a floor mid-ramp.)
+TEST(FloorTracker, StandingStillOrWalkingOnARampNeverStartsAFloor) {
+  for (double deg : {5.0, 10.0}) {
+    FloorTracker ft;
+    ft.update(at(0.0), 0.0);
+    const double slope = std::tan(deg * M_PI / 180.0);
+    double t = 0, x = 0;
+    std::vector<double> changes;
+    auto walk = [&](double dx, double z_top, double dt_total) {
+      const int n = int(dt_total / 0.1);
+      for (int i = 0; i < n; ++i, t += 0.1) {
+        x += dx / n;
+        if (ft.update({x, 0.0, std::min(z_top, slope * x)}, t)) changes.push_back(slope * x);
+      }
+    };
+    walk(1.8 / slope, 3.0, 1.8 / slope / 0.5);  // up to 1.8 m at 0.5 m/s
+    walk(0.0, 3.0, 10.0);                       // standing mid-ramp
+    walk(0.1, 3.0, 0.5);                        // a few steps on
+    walk(0.0, 3.0, 10.0);                       // and again
+    walk(3.0 / slope - x, 3.0, 30.0);           // to the top
+    EXPECT_TRUE(changes.empty()) << deg << " deg: a floor at " << changes.front() << " m";
+    EXPECT_EQ(ft.current(), 0);
+    walk(2.0, 3.0, 4.0);  // on the upper floor
+    ASSERT_EQ(changes.size(), 1u) << deg << " deg";
+    EXPECT_EQ(ft.current(), 1);
+    EXPECT_NEAR(ft.floor(1).z_m, 3.0, 1e-9);
+  }
 }

@@ -69,7 +69,7 @@ TEST(HybridGraph, ClosedDoorSplitsTheZoneAndReassignsTheCutOffPart) {
   for (bool maintain : {true, false}) {
     Harness h;
     FloorTracker ft;
-    ft.update(0.0, 0.0);
+    ft.update(Eigen::Vector3d::Zero(), 0.0);
     HybridGraph hg;
     hg.init_prior(prior.g, prior.zones, 0.0, 0);
     PlanOptions opt;
@@ -120,7 +120,7 @@ TEST(HybridGraph, HypothesisConfirmedWhenObservedAndDiscardedAfterRepeatedEmptyO
   const ZonePartition zones = part.partition(g, t.clearance, {6.0, 4});
   Harness h;
   FloorTracker ft;
-  ft.update(0.0, 0.0);
+  ft.update(Eigen::Vector3d::Zero(), 0.0);
   HybridGraph hg;
   hg.init_prior(g, zones, 0.0, 0);
   PlanOptions opt;
@@ -167,7 +167,7 @@ TEST(HybridGraph, ChangedRegionsLimitReChecksToWhereTheMapChanged) {
   const ZonePartition zones = part.partition(g, t.clearance, {6.0, 4});
   Harness h;
   FloorTracker ft;
-  ft.update(0.0, 0.0);
+  ft.update(Eigen::Vector3d::Zero(), 0.0);
   HybridGraph full, regions;
   full.init_prior(g, zones, 0.0, 0);
   regions.init_prior(g, zones, 0.0, 0);
@@ -216,7 +216,7 @@ TEST(HybridGraph, HypothesesComingIntoRangeAreCheckedWithoutAChangeNearThem) {
   const ZonePartition zones = part.partition(g, t.clearance, {6.0, 4});
   Harness h;
   FloorTracker ft;
-  ft.update(0.0, 0.0);
+  ft.update(Eigen::Vector3d::Zero(), 0.0);
   HybridGraph hg;
   hg.init_prior(g, zones, 0.0, 0);
   PlanOptions opt;
