@@ -125,12 +125,22 @@ BsplineTrajectory TrajectoryBuilder::fit(std::span<const Eigen::Vector3d> wp,
   const int n = int(c.size());
   std::vector<double> y(size_t(n), yaw_start);
   double carry = yaw_start;
+  bool backwards = true;  // still on the flight the path starts down, facing up it
   for (int q = 3; q < n - 3; ++q) {
     int lo = q, hi = q;
     while (lo > 0 && (c[lo] - c[q]).head<2>().norm() < 1e-6) --lo;
     while (hi < n - 1 && (c[hi] - c[q]).head<2>().norm() < 1e-6) ++hi;
     const Eigen::Vector3d d = c[hi] - c[lo];
-    if (d.head<2>().norm() > 1e-6) carry = std::atan2(d.y(), d.x());
+    if (d.head<2>().norm() > 1e-6) {
+      carry = std::atan2(d.y(), d.x());
+      // A path that starts down a flight the robot stands on facing up it is walked backwards
+      // until the flight ends: the 0.7 m body has no room to turn round between a flight's side
+      // walls (a robot that had climbed part of test_stair could plan no way back), and the
+      // LiDAR sees all round. Paths that reach a flight from level ground descend it forwards.
+      backwards = backwards && d.z() < 0 && is_flight(robot_, -d.z(), d.head<2>().norm()) &&
+                  std::abs(wrap(carry + M_PI - yaw_start)) < 0.5 * M_PI;
+      if (backwards) carry += M_PI;
+    }
     y[q] = carry;
   }
   for (int q = std::max(3, n - 3); q < n; ++q) y[q] = yaw_goal ? *yaw_goal : carry;

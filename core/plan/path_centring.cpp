@@ -26,9 +26,7 @@ bool obstacle_at(const map::MapView& view, int32_t kx, int32_t ky, double h) {
 // ground following the ramp's grade.
 bool flight_step(const RobotModel& r, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                  double voxel_m) {
-  const double dz = std::abs(b.z() - a.z());
-  if (dz <= 0.5 * r.step_height_m) return false;
-  return dz > std::tan(0.6 * r.max_slope_rad) * std::max((b - a).head<2>().norm(), voxel_m);
+  return is_flight(r, std::abs(b.z() - a.z()), std::max((b - a).head<2>().norm(), voxel_m));
 }
 
 }  // namespace

@@ -174,13 +174,18 @@ TEST(BsplineTrajectory, PathThroughAnObstacleIsReported) {
   EXPECT_TRUE(r.hit.collides);
 }
 
-TEST(BsplineTrajectory, ClimbsStairsWithoutCollision) {
+World stair_world() {
   World w;
   w.add(aabb({-3, -1.5f, -0.2f}, {1, 1.5f, 0}));
   w.stairs(1, -0.8f, 0.8f, 0, 6, 0.15f, 0.30f);
   w.add(aabb({2.8f, -1.5f, -0.2f}, {6, 1.5f, 0.9f}));
   w.add(aabb({-3, -1.7f, 0}, {6, -1.5f, 3.0f}));
   w.add(aabb({-3, 1.5f, 0}, {6, 1.7f, 3.0f}));
+  return w;
+}
+
+TEST(BsplineTrajectory, ClimbsStairsWithoutCollision) {
+  const World w = stair_world();
   map::TraversabilityMap m;
   storey::test::scan_world(
       m, w, {{-1, 0, 0.5f}, {0.5f, 0, 0.5f}, {1.9f, 0, 0.95f}, {4, 0, 1.4f}, {3, 0, 1.4f}});
@@ -197,6 +202,47 @@ TEST(BsplineTrajectory, ClimbsStairsWithoutCollision) {
   EXPECT_NEAR(r.trajectory.sample(r.trajectory.t_end()).p_m.z(), vp.points_m.back().z(), 1e-9);
   EXPECT_EQ(count_body_intrusions(view, r.trajectory, robot), 0);
   expect_limits(r.trajectory, robot);
+}
+
+// Down the same flight from its fifth tread, facing up it (a robot that climbed part of it): the
+// body walks down backwards, still facing up, and turns round only on the lower floor. From the
+// landing, a path down the flight is walked forwards as before (the robot turns on the landing).
+TEST(BsplineTrajectory, WalksDownAFlightItStandsOnBackwards) {
+  const World w = stair_world();
+  map::TraversabilityMap m;
+  storey::test::scan_world(
+      m, w, {{-1, 0, 0.5f}, {0.5f, 0, 0.5f}, {1.9f, 0, 0.95f}, {4, 0, 1.4f}, {3, 0, 1.4f}});
+  const map::MapView view = m.view();
+  RobotModel robot;
+  VoxelAStar astar(VoxelAStarOptions{.reachable_only = false});
+  CollisionChecker cc(robot, view.voxel_size_m());
+  TrajectoryBuilder tb(robot, TrajectoryOptions{.reachable_only = false});
+  for (const Eigen::Vector3d start : {Eigen::Vector3d(2.35, 0, 0.75), Eigen::Vector3d(4, 0, 0.9)}) {
+    const bool on_flight = start.x() < 2.8;
+    const VoxelPath vp = astar.plan(view, start, {-1, 0, 0});
+    ASSERT_EQ(vp.status, VoxelAStarStatus::kOk) << to_string(vp.status);
+    const TrajectoryResult r = tb.build(view, cc, vp.points_m, 0.0, std::nullopt, 0.0);
+    ASSERT_TRUE(r.status == TrajectoryStatus::kOk || r.status == TrajectoryStatus::kPolyline)
+        << to_string(r.status) << " hit at t=" << r.hit.t_s << " voxel "
+        << r.hit.voxel_m.transpose();
+    int mid_flight = 0;
+    for (double t = r.trajectory.t_start(); t <= r.trajectory.t_end(); t += 0.05) {
+      const TrajectorySample s = r.trajectory.sample(t);
+      if (s.p_m.x() > 1.3 && s.p_m.x() < 2.2) {  // treads 2..4
+        ++mid_flight;
+        const double facing_up = std::abs(std::remainder(s.yaw_rad, 2 * M_PI));
+        if (on_flight)
+          EXPECT_LT(facing_up, 0.3) << "t " << t << " x " << s.p_m.x() << " yaw " << s.yaw_rad;
+        else
+          EXPECT_GT(facing_up, M_PI - 0.3) << "t " << t << " x " << s.p_m.x();
+      }
+    }
+    EXPECT_GT(mid_flight, 5);
+    const double end_yaw = r.trajectory.sample(r.trajectory.t_end()).yaw_rad;
+    EXPECT_NEAR(std::abs(std::remainder(end_yaw, 2 * M_PI)), M_PI, 0.3);  // facing down the room
+    EXPECT_EQ(count_body_intrusions(view, r.trajectory, robot), 0);
+    expect_limits(r.trajectory, robot);
+  }
 }
 
 }  // namespace
