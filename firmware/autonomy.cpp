@@ -276,7 +276,8 @@ void Autonomy::plan_step() {
   };
   ExplorationStatus s;
   if (r.floor_changed && r.floor >= 0)
-    plan_q_.try_push(PlanEvent{PlanEvent::kFloor, now, r.floor, r.reference_floor, r.dz_m, ""});
+    plan_q_.try_push(PlanEvent{PlanEvent::kFloor, now, r.floor, r.reference_floor, r.dz_m, "",
+                               float(pose.x_m), float(pose.y_m), float(pose.z_m)});
   if (r.prior_built)
     plan_q_.try_push(PlanEvent{PlanEvent::kPrior, now, r.floor, r.reference_floor, r.dz_m, ""});
   if (r.status != PS::kFailed) last_failure_ = nullptr;
@@ -531,7 +532,8 @@ void Autonomy::telemetry_step() {
   while (plan_q_.try_pop(p)) {
     switch (p.kind) {
       case PlanEvent::kFloor:
-        std::snprintf(line, sizeof line, "t=%.2f s: on floor %d", p.t_s, p.floor);
+        std::snprintf(line, sizeof line, "t=%.2f s: on floor %d (robot at %.2f, %.2f, %.2f m)",
+                      p.t_s, p.floor, double(p.x_m), double(p.y_m), double(p.z_m));
         break;
       case PlanEvent::kPrior:
         std::snprintf(line, sizeof line,

@@ -91,7 +91,8 @@ struct PlanEvent {
   double t_s = 0;
   int32_t floor = -1, reference_floor = -1;
   double dz_m = 0;
-  const char* reason = "";  // string literal
+  const char* reason = "";          // string literal
+  float x_m = 0, y_m = 0, z_m = 0;  // kFloor: where the robot stood
 };
 
 struct StopEvent {

@@ -12,7 +12,7 @@ bool FloorTracker::update(const Eigen::Vector3d& foot, double t) {
     return false;
   }
   if (current_ < 0) {
-    floors_.push_back({0, z, t, false, 1.0, 0});
+    floors_.push_back({0, z, t, false, 1.0, 0, z});
     current_ = 0;
     changed_to_new_ = true;
     return true;
@@ -40,7 +40,7 @@ bool FloorTracker::update(const Eigen::Vector3d& foot, double t) {
   changed_to_new_ = best < 0;
   if (best < 0) {
     best = int32_t(floors_.size());
-    floors_.push_back({best, z, t, false, 1.0, 0});
+    floors_.push_back({best, z, t, false, 1.0, 0, z});
   }
   current_ = best;
   return true;
@@ -87,7 +87,9 @@ void FloorTracker::refine(std::span<const float> node_z) {
         ++cnt;
       }
     }
-    if (cnt > 0) f.z_m = sum / cnt;
+    if (cnt > 0)
+      f.z_m = std::clamp(sum / cnt, f.anchor_z_m - opt_.max_refine_shift_m,
+                         f.anchor_z_m + opt_.max_refine_shift_m);
   }
 }
 

@@ -8,11 +8,15 @@
 // within that band; the robot is then on the known floor within floor_change_dz_m / 2 of that
 // height, or on a new floor. Heights between floors never start a floor: on stairs the height
 // does not stay put, and on a ramp it cannot stay in the band over stable_travel_m (slopes
-// steeper than atan(stable_band_m / stable_travel_m), 4.6 deg by default), even where the robot
-// stands still mid-ramp for a while (it used to start a floor there).
+// steeper than atan(stable_band_m / stable_travel_m), 2.3 deg by default; zigzagging across a
+// 1.5 m wide 5 deg ramp got through a 0.12 m / 1.5 m window), even where the robot stands still
+// mid-ramp for a while (it used to start a floor there).
 // Nodes are labelled by the floor whose height is nearest their support height, within
 // node_band_m (else -1: stairs, ramps, unknown floors). A floor's height is refined from its
-// nodes: the mode of their support heights (histogram of mode_bin_m), mean of that bin.
+// nodes: the mode of their support heights (histogram of mode_bin_m), mean of that bin, kept
+// within max_refine_shift_m of the robot's height on that floor (without the anchor the band
+// followed the mode up a ramp once most of a floor's nodes were gone: Maze's floor 0 drifted to
+// 1.41 m and the prior for floor 1 was built with dz 1.59 m).
 // dz(ref, target) = difference of the two modes. The reference floor for a target floor is the
 // most completely explored adjacent floor (nearest below or above).
 #include <Eigen/Core>
@@ -23,13 +27,15 @@
 namespace storey::core::plan {
 
 struct FloorTrackerOptions {
-  double floor_change_dz_m = 1.5;  // support height change that means another floor
-  double stable_s = 2.0;           // the new height must hold this long
-  double stable_band_m = 0.12;     // ... within this band
-  double stable_travel_m = 1.5;    // ... while the robot walks this far (horizontal) in it
-  double node_band_m = 0.6;        // nodes within this of a floor's height belong to it
-  double mode_bin_m = 0.1;         // histogram bin of the height mode
-  int min_mode_nodes = 10;         // fewer nodes: keep the robot-derived height
+  double floor_change_dz_m = 1.5;    // support height change that means another floor
+  double stable_s = 2.0;             // the new height must hold this long
+  double stable_band_m = 0.08;       // ... within this band
+  double stable_travel_m = 2.0;      // ... while the robot walks this far (horizontal) in it
+  double node_band_m = 0.6;          // nodes within this of a floor's height belong to it
+  double mode_bin_m = 0.1;           // histogram bin of the height mode
+  int min_mode_nodes = 10;           // fewer nodes: keep the robot-derived height
+  double max_refine_shift_m = 0.25;  // the mode moves a floor at most this far from where the
+                                     // robot stood on it
 };
 
 struct Floor {
@@ -39,6 +45,7 @@ struct Floor {
   bool explored = false;    // no work left on it when last checked (set by the planner)
   double open_ratio = 1.0;  // frontier nodes / nodes when last checked (0 = fully explored)
   int nodes = 0;            // nodes labelled with this floor when last refined
+  double anchor_z_m = 0;    // the robot's support height when the floor was created
 };
 
 class FloorTracker {

@@ -31,8 +31,8 @@ struct PlanOptions {
   double lookahead_s = 1.0;  // T: check the next T seconds of the trajectory
   // Macro layer (Sec. IV-A..C; exploration_planner.hpp).
   double floor_stable_s = 2.0;           // new support height must hold this long (floor change)
-  double floor_stable_band_m = 0.12;     // ... within this band
-  double floor_stable_travel_m = 1.5;    // ... while the robot walks this far in it
+  double floor_stable_band_m = 0.08;     // ... within this band
+  double floor_stable_travel_m = 2.0;    // ... while the robot walks this far in it
   double floor_node_band_m = 0.6;        // nodes within this of a floor's height belong to it
   double zone_clearance_radius_m = 3.0;  // bounded obstacle search for zone seeds (IV-A)
   double hyp_height_window_m = 0.5;      // |z - projected z| for promotion / merge (dz error)
