@@ -60,36 +60,38 @@ int32_t FloorTracker::floor_of(double z) const {
 }
 
 void FloorTracker::refine(std::span<const float> node_z) {
-  const int bins = std::max(1, int(std::ceil(2 * opt_.node_band_m / opt_.mode_bin_m)));
+  // The mode is taken only over nodes within max_refine_shift_m of where the robot stood on the
+  // floor; with fewer than min_mode_nodes there the floor keeps its height.
+  const double w = opt_.max_refine_shift_m;
+  const int bins = std::max(1, int(std::ceil(2 * w / opt_.mode_bin_m)));
   for (Floor& f : floors_) {
     hist_.assign(size_t(bins), 0);
-    const double lo = f.z_m - opt_.node_band_m;
-    int n = 0;
+    const double lo = f.anchor_z_m - w;
+    int n = 0, near = 0;
     for (float zf : node_z) {
       const double zz = zf;
       if (floor_of(zz) != f.id) continue;
-      const int b = std::clamp(int((zz - lo) / opt_.mode_bin_m), 0, bins - 1);
-      ++hist_[size_t(b)];
       ++n;
+      if (std::abs(zz - f.anchor_z_m) > w) continue;
+      ++hist_[size_t(std::clamp(int((zz - lo) / opt_.mode_bin_m), 0, bins - 1))];
+      ++near;
     }
     f.nodes = n;
-    if (n < opt_.min_mode_nodes) continue;
+    if (near < opt_.min_mode_nodes) continue;
     const int mode = int(std::max_element(hist_.begin(), hist_.end()) - hist_.begin());
     // Mean of the node heights in the mode bin and its two neighbours.
     double sum = 0;
     int cnt = 0;
     for (float zf : node_z) {
       const double zz = zf;
-      if (floor_of(zz) != f.id) continue;
+      if (floor_of(zz) != f.id || std::abs(zz - f.anchor_z_m) > w) continue;
       const int b = std::clamp(int((zz - lo) / opt_.mode_bin_m), 0, bins - 1);
       if (std::abs(b - mode) <= 1) {
         sum += zz;
         ++cnt;
       }
     }
-    if (cnt > 0)
-      f.z_m = std::clamp(sum / cnt, f.anchor_z_m - opt_.max_refine_shift_m,
-                         f.anchor_z_m + opt_.max_refine_shift_m);
+    if (cnt > 0) f.z_m = sum / cnt;
   }
 }
 

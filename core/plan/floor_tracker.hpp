@@ -13,8 +13,8 @@
 // mid-ramp for a while (it used to start a floor there).
 // Nodes are labelled by the floor whose height is nearest their support height, within
 // node_band_m (else -1: stairs, ramps, unknown floors). A floor's height is refined from its
-// nodes: the mode of their support heights (histogram of mode_bin_m), mean of that bin, kept
-// within max_refine_shift_m of the robot's height on that floor (without the anchor the band
+// nodes within max_refine_shift_m of the robot's height on that floor: the mode of their
+// support heights (histogram of mode_bin_m), mean of that bin (without the anchor the band
 // followed the mode up a ramp once most of a floor's nodes were gone: Maze's floor 0 drifted to
 // 1.41 m and the prior for floor 1 was built with dz 1.59 m).
 // dz(ref, target) = difference of the two modes. The reference floor for a target floor is the
