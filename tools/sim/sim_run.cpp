@@ -323,6 +323,7 @@ SimRunResult run_exploration(const SimRunOptions& opt) {
   const std::int64_t limit_ns = std::int64_t(std::llround(opt.time_limit_s * 1e9));
   const std::int64_t progress_ns = std::int64_t(std::llround(opt.progress_period_s * 1e9));
   std::int64_t t_ns = 0, next_progress = progress_ns, next_path = 0;
+  uint32_t collisions_seen = 0, falls_seen = 0;
   std::string error;
   try {
     for (;;) {
@@ -330,6 +331,19 @@ SimRunResult run_exploration(const SimRunOptions& opt) {
       platform.step(double(kSliceNs) * 1e-9);      // world: [t, t + slice) with the command
       t_ns += kSliceNs;
       const double t = double(t_ns) * 1e-9;
+      // Every collision and fall is logged where it happened (the metrics only count them).
+      if (const auto& rs = world.robot_state();
+          rs.collisions != collisions_seen || rs.falls != falls_seen) {
+        char line[200];
+        std::snprintf(line, sizeof line,
+                      "  sim: t=%.2f s: %s at (%.2f, %.2f, %.2f) m, yaw %.0f deg, pitch %.0f deg",
+                      t, rs.collisions != collisions_seen ? "body collision" : "fall",
+                      rs.position.x(), rs.position.y(), rs.position.z(), rs.yaw * 180 / M_PI,
+                      rs.pitch * 180 / M_PI);
+        progress(line);
+        collisions_seen = rs.collisions;
+        falls_seen = rs.falls;
+      }
       if (t_ns >= next_path) {
         path.push_back(world.robot_state().position);
         next_path += 200'000'000;  // 5 Hz
