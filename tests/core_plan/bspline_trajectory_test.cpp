@@ -184,11 +184,16 @@ World stair_world() {
   return w;
 }
 
-TEST(BsplineTrajectory, ClimbsStairsWithoutCollision) {
-  const World w = stair_world();
-  map::TraversabilityMap m;
+// The stair world scanned from the lower floor, the flight and the landing.
+void scan_stairs(map::TraversabilityMap& m) {
   storey::test::scan_world(
-      m, w, {{-1, 0, 0.5f}, {0.5f, 0, 0.5f}, {1.9f, 0, 0.95f}, {4, 0, 1.4f}, {3, 0, 1.4f}});
+      m, stair_world(),
+      {{-1, 0, 0.5f}, {0.5f, 0, 0.5f}, {1.9f, 0, 0.95f}, {4, 0, 1.4f}, {3, 0, 1.4f}});
+}
+
+TEST(BsplineTrajectory, ClimbsStairsWithoutCollision) {
+  map::TraversabilityMap m;
+  scan_stairs(m);
   const map::MapView view = m.view();
   RobotModel robot;
   VoxelAStar astar(VoxelAStarOptions{.reachable_only = false});
@@ -208,10 +213,8 @@ TEST(BsplineTrajectory, ClimbsStairsWithoutCollision) {
 // body walks down backwards, still facing up, and turns round only on the lower floor. From the
 // landing, a path down the flight is walked forwards as before (the robot turns on the landing).
 TEST(BsplineTrajectory, WalksDownAFlightItStandsOnBackwards) {
-  const World w = stair_world();
   map::TraversabilityMap m;
-  storey::test::scan_world(
-      m, w, {{-1, 0, 0.5f}, {0.5f, 0, 0.5f}, {1.9f, 0, 0.95f}, {4, 0, 1.4f}, {3, 0, 1.4f}});
+  scan_stairs(m);
   const map::MapView view = m.view();
   RobotModel robot;
   VoxelAStar astar(VoxelAStarOptions{.reachable_only = false});
