@@ -49,7 +49,7 @@ std::optional<Support> SupportQuery::surface_near(float x, float y, float z, flo
     // rejected by the body clearance, the slab's top lies within the body height.)
     if (occ && !above) {
       const map::VoxelStats* st = c->stats == Cell::kNoStats ? nullptr : reader_.stats(k);
-      const float h = (float(kz) + 0.5f) * vs_ + (st && st->count ? st->mean[2] : 0.0f);
+      const float h = (float(kz) + 0.5f) * vs_ + map::surface_offset(st, vs_);
       const float d = std::abs(h - z);
       if (d <= window && d < best_d) {
         best_d = d;
@@ -115,7 +115,7 @@ bool SupportQuery::body_clear(float x, float y, float h, const Eigen::Vector2f& 
       const Cell* c = cell(k);
       if (!occupied(c)) continue;
       const map::VoxelStats* st = c->stats == Cell::kNoStats ? nullptr : reader_.stats(k);
-      const float hv = (float(kz) + 0.5f) * vs_ + (st && st->count ? st->mean[2] : 0.0f);
+      const float hv = (float(kz) + 0.5f) * vs_ + map::surface_offset(st, vs_);
       if (hv > h + col_lo_ && hv <= h + clear_) return false;
     }
   }

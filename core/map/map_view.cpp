@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <limits>
 
+#include "core/map/point_plane.hpp"
 #include "core/map/voxel_ray.hpp"
 
 namespace storey::core::map {
@@ -60,6 +61,23 @@ uint32_t MapView::point_count(const VoxelKey& k) const {
   return s ? s->count : 0;
 }
 
+bool MapView::is_step_edge(const VoxelKey& k) const {
+  BlockReader& r = reader();
+  if (occupancy_of(r.cell(k), occ_threshold(*opt_)) != Occupancy::kOccupied) return false;
+  const VoxelStats* s = r.stats(k);
+  return s && (s->shape & VoxelStats::kStepEdge);
+}
+
+std::optional<Eigen::Vector2f> MapView::riser_normal(const VoxelKey& k) const {
+  BlockReader& r = reader();
+  if (occupancy_of(r.cell(k), occ_threshold(*opt_)) != Occupancy::kOccupied) return std::nullopt;
+  const VoxelStats* s = r.stats(k);
+  if (!s || !(s->shape & VoxelStats::kStepEdge)) return std::nullopt;
+  const Eigen::Vector2d n = point_plane(*s).normal.head<2>();
+  if (n.norm() < 1e-6) return std::nullopt;
+  return n.normalized().cast<float>();
+}
+
 float MapView::cost(const VoxelKey& k) const {
   BlockReader& r = reader();
   const VoxelStats* s = r.stats(k);
@@ -71,7 +89,7 @@ std::optional<float> MapView::surface_height_m(const VoxelKey& k) const {
   if (occupancy_of(r.cell(k), occ_threshold(*opt_)) != Occupancy::kOccupied) return std::nullopt;
   const VoxelStats* s = r.stats(k);
   const float centre = float((k.z + 0.5) * opt_->voxel_size_m);
-  return s && s->count ? centre + s->mean[2] : centre;
+  return centre + surface_offset(s, float(opt_->voxel_size_m));
 }
 
 std::optional<SurfacePoint> MapView::support_surface_near(const Eigen::Vector3f& p,
@@ -91,7 +109,7 @@ std::optional<SurfacePoint> MapView::support_surface_near(const Eigen::Vector3f&
     const bool occupied = occupancy_of(cell, occ) == Occupancy::kOccupied;
     if (occupied && !above_occupied) {
       const VoxelStats* st = cell->stats == Cell::kNoStats ? nullptr : r.stats(k);
-      const float h = float((z + 0.5) * s) + (st && st->count ? st->mean[2] : 0.0f);
+      const float h = float((z + 0.5) * s) + surface_offset(st, float(s));
       const float d = std::abs(h - p.z());
       if (d <= window_m && d < best_d) {
         best_d = d;
@@ -206,7 +224,7 @@ size_t MapView::occupied_extents_in_box(const Eigen::Vector3f& centre, const Eig
         e.half_m = Eigen::Vector3f::Constant(hs);
         e.surface_z_m = e.centre_m.z();
         const VoxelStats* st = r.stats(k);
-        if (st && st->count) e.surface_z_m += st->mean[2];
+        e.surface_z_m += surface_offset(st, float(opt_->voxel_size_m));
         if (st && st->count >= uint32_t(std::max(1, opt_->n_min))) {
           const float var[3] = {st->m2[0], st->m2[3], st->m2[5]};  // xx, yy, zz scatter sums
           for (int a = 0; a < 3; ++a) {

@@ -91,6 +91,10 @@ class MapView {
   bool is_reachable(const VoxelKey& k) const;     // v in C_reach
   uint32_t point_count(const VoxelKey& k) const;  // N(v)
   float cost(const VoxelKey& k) const;            // c(v), Eq. 2 (0 if never evaluated)
+  bool is_step_edge(const VoxelKey& k) const;     // occupied, VoxelStats::kStepEdge
+  // A step edge's riser (VoxelStats::kStepEdge): the horizontal unit normal of its points
+  // (sign arbitrary); nullopt if k is not an occupied step edge.
+  std::optional<Eigen::Vector2f> riser_normal(const VoxelKey& k) const;
   // Surface height of an occupied voxel: centre z + mean of its points [m].
   std::optional<float> surface_height_m(const VoxelKey& k) const;
 

@@ -54,7 +54,7 @@ PlyExportResult write_ply_occupied(const MapView& map, const std::string& path) 
                  160,
                  160,
                  uint8_t(c.state),
-                 uint8_t(st ? st->reasons : 0),
+                 uint8_t(st ? st->reasons | ((st->shape & VoxelStats::kStepEdge) ? 0x80 : 0) : 0),
                  uint16_t(st ? std::min<uint32_t>(st->count, 65535u) : 0)};
     if (c.flags & Cell::kReachable) {
       pv.r = 40, pv.g = 90, pv.b = 230, pv.state = 4;
@@ -74,7 +74,7 @@ PlyExportResult write_ply_reachable(const MapView& map, const std::string& path)
   map.for_each_occupied([&](const VoxelKey& k, const Cell& c, const VoxelStats* st) {
     if (!(c.flags & Cell::kReachable)) return;
     const Eigen::Vector3f p = map.centre_of(k);
-    const float h = st && st->count ? p.z() + st->mean[2] : p.z() + 0.5f * s;
+    const float h = st && st->count ? p.z() + surface_offset(st, s) : p.z() + 0.5f * s;
     v.push_back(PlyVertex{p.x(), p.y(), h, 40, 90, 230, 4, 0,
                           uint16_t(st ? std::min<uint32_t>(st->count, 65535u) : 0)});
   });

@@ -1,7 +1,8 @@
 // TraversabilityMap: the connected reachable set C_reach (paper Sec. III-A, last paragraph).
 //
-// Adjacency: two traversable support voxels in 8-connected neighbouring columns whose surface
-// heights differ by at most the step height (slope is already bounded per voxel by c(v)); any
+// Adjacency: two traversable support voxels in 8-connected neighbouring columns, or one stride
+// apart across a column with nothing standing in it (stride_clear), whose surface heights
+// differ by at most the step height (slope is already bounded per voxel by c(v)); any
 // number of floors can stack over one column. Maintenance is a dynamic BFS tree: every member
 // stores its hop count from the root, and every member but the root has a neighbour with a
 // smaller count. Growth adds voxels with parent count + 1. Removal (a member turned
@@ -19,8 +20,30 @@
 namespace storey::core::map {
 
 namespace {
-constexpr int kDx[8] = {1, -1, 0, 0, 1, 1, -1, -1};
-constexpr int kDy[8] = {0, 0, 1, -1, 1, -1, 1, -1};
+// The 8 neighbouring columns, then the 8 one stride away (two voxels, straight or diagonal).
+constexpr int kNeighbours = 16;
+constexpr int kDx[kNeighbours] = {1, -1, 0, 0, 1, 1, -1, -1, 2, -2, 0, 0, 2, 2, -2, -2};
+constexpr int kDy[kNeighbours] = {0, 0, 1, -1, 1, -1, 1, -1, 0, 0, 2, -2, 2, -2, 2, -2};
+
+// A stride up or down a step (heights differ by at least kMinStrideRiseM) crosses the column
+// between a and b if nothing in it stands more than a step above the higher end (a wall, a
+// post): a Go2's stride clears the one-voxel strip of a stair tread the LiDAR did not see (seen
+// edge-on from below, rays grazing over it keep its voxels free). Level ground with a hole in
+// the map stays unbridged: that is what tentative edges are for.
+constexpr float kMinStrideRiseM = 0.08f;
+template <typename Occupied, typename Height>
+bool stride_clear(const VoxelKey& a, const VoxelKey& b, float ha, float hb, int below, int above,
+                  float step, Occupied&& occupied, Height&& height) {
+  if (std::abs(b.x - a.x) < 2 && std::abs(b.y - a.y) < 2) return true;
+  if (std::abs(hb - ha) < kMinStrideRiseM) return false;
+  const float h_top = std::max(ha, hb);
+  const int32_t mx = a.x + (b.x - a.x) / 2, my = a.y + (b.y - a.y) / 2;
+  for (int32_t z = std::min(a.z, b.z) - below; z <= std::max(a.z, b.z) + above; ++z) {
+    const VoxelKey m{mx, my, z};
+    if (occupied(m) && height(m) > h_top + step) return false;
+  }
+  return true;
+}
 }  // namespace
 
 bool TraversabilityMap::connected(const VoxelKey& a, const VoxelKey& b) {
@@ -29,11 +52,16 @@ bool TraversabilityMap::connected(const VoxelKey& a, const VoxelKey& b) {
   const float ha = surface_height(a, rstats(a));
   const Cell* cb = rcell(b);
   if (!cb || cb->state != TravState::kTraversable) return false;
-  return std::abs(surface_height(b, rstats(b)) - ha) <= robot_.step_height_m;
+  const float hb = surface_height(b, rstats(b));
+  if (std::abs(hb - ha) > robot_.step_height_m + step_slack(rstats(a), rstats(b))) return false;
+  return stride_clear(
+      a, b, ha, hb, dz_step_, h_clear_, float(robot_.step_height_m),
+      [&](const VoxelKey& m) { return occupied(rcell(m)); },
+      [&](const VoxelKey& m) { return surface_height(m, rstats(m)); });
 }
 
 bool TraversabilityMap::has_parent(const VoxelKey& k, uint32_t dist) {
-  for (int i = 0; i < 8; ++i)
+  for (int i = 0; i < kNeighbours; ++i)
     for (int dz = -dz_step_; dz <= dz_step_; ++dz) {
       const VoxelKey w{k.x + kDx[i], k.y + kDy[i], k.z + dz};
       const Cell* cw = rcell(w);
@@ -94,7 +122,7 @@ void TraversabilityMap::grow_bfs(ReachUpdateStats& st) {
   for (size_t q = 0; q < grow_queue_.size(); ++q) {
     const VoxelKey u = grow_queue_[q];
     const uint32_t du = rstats(u)->reach_dist;
-    for (int i = 0; i < 8; ++i)
+    for (int i = 0; i < kNeighbours; ++i)
       for (int dz = -dz_step_; dz <= dz_step_; ++dz) {
         const VoxelKey w{u.x + kDx[i], u.y + kDy[i], u.z + dz};
         const Cell* cw = rcell(w);
@@ -189,7 +217,7 @@ ReachUpdateStats TraversabilityMap::update_reachable(const Eigen::Vector3f& foot
   }
   for (size_t q = 0; q < orphan_queue_.size(); ++q) {
     const auto [u, du] = orphan_queue_[q];
-    for (int i = 0; i < 8; ++i)
+    for (int i = 0; i < kNeighbours; ++i)
       for (int dz = -dz_step_; dz <= dz_step_; ++dz) {
         const VoxelKey w{u.x + kDx[i], u.y + kDy[i], u.z + dz};
         const Cell* cw = rcell(w);
@@ -209,7 +237,7 @@ ReachUpdateStats TraversabilityMap::update_reachable(const Eigen::Vector3f& foot
     const Cell* c = rcell(k);
     if (!c || c->state != TravState::kTraversable || (c->flags & Cell::kReachable)) return;
     uint32_t best = std::numeric_limits<uint32_t>::max();
-    for (int i = 0; i < 8; ++i)
+    for (int i = 0; i < kNeighbours; ++i)
       for (int dz = -dz_step_; dz <= dz_step_; ++dz) {
         const VoxelKey w{k.x + kDx[i], k.y + kDy[i], k.z + dz};
         const Cell* cw = rcell(w);
@@ -263,10 +291,19 @@ std::vector<VoxelKey> TraversabilityMap::grow_from_scratch(
   for (size_t q = 0; q < out.size(); ++q) {
     const VoxelKey u = out[q];
     const float hu = height(u);
-    for (int i = 0; i < 8; ++i)
+    for (int i = 0; i < kNeighbours; ++i)
       for (int dz = -dz_step_; dz <= dz_step_; ++dz) {
         const VoxelKey w{u.x + kDx[i], u.y + kDy[i], u.z + dz};
-        if (seen.count(w) || !trav(w) || std::abs(height(w) - hu) > robot_.step_height_m) continue;
+        if (seen.count(w) || !trav(w) ||
+            std::abs(height(w) - hu) > robot_.step_height_m + step_slack(r.stats(u), r.stats(w)))
+          continue;
+        auto occ = [&](const VoxelKey& m) {
+          const Cell* c = r.cell(m);
+          return c && (c->flags & Cell::kObserved) && c->log_odds > occ_q_;
+        };
+        if (!stride_clear(u, w, hu, height(w), dz_step_, h_clear_, float(robot_.step_height_m), occ,
+                          height))
+          continue;
         seen.insert(w);
         out.push_back(w);
       }

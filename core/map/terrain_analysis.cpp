@@ -3,6 +3,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "core/map/point_plane.hpp"
 #include "core/map/traversability_map.hpp"
 
 namespace storey::core::map {
@@ -29,8 +30,19 @@ TravUpdateStats TraversabilityMap::update_traversability() {
   }
   changed_.clear();
 
-  // 2. Re-evaluate. evaluate() reads only statistics and occupancy of neighbours, never their
-  //    states, so the order of the dirty set does not matter.
+  // 2. Step edges first: evaluate() reads the neighbours' surface heights, which depend on it.
+  for (const VoxelKey& k : dirty_) {
+    const Cell* c = rcell(k);
+    if (!c || c->stats == Cell::kNoStats) continue;
+    const bool edge = occupied(c) && step_edge(k, *reader_.stats(k));
+    if (edge == bool(reader_.stats(k)->shape & VoxelStats::kStepEdge)) continue;
+    VoxelBlock* b = wblock(k, false);
+    VoxelStats& st = b->stats[b->cells[cell_index(k)].stats];
+    st.shape = edge ? (st.shape | VoxelStats::kStepEdge) : (st.shape & ~VoxelStats::kStepEdge);
+  }
+
+  // 3. Re-evaluate. evaluate() reads only statistics, step-edge shapes and occupancy of
+  //    neighbours, never their states, so the order of the dirty set does not matter.
   for (const VoxelKey& k : dirty_) {
     VoxelBlock* b = wblock(k, false);
     Cell& c = b->cells[cell_index(k)];
@@ -66,6 +78,61 @@ TravUpdateStats TraversabilityMap::update_traversability() {
   return st;
 }
 
+namespace {
+// Points on a tilted sheet (thin across, spread along; 2 cm range noise makes risers ~1.5 cm
+// thick) more than 15 deg off level: a riser, or a riser with a strip of its tread on top (a
+// nosing in mid-voxel).
+bool steep_sheet(const PointPlane& p) {
+  const Eigen::Vector3d& ev = p.eigenvalues;
+  return ev[1] > 0 && ev[0] < 0.6 * ev[1] && std::abs(p.normal.z()) < std::cos(M_PI / 12);
+}
+}  // namespace
+
+bool TraversabilityMap::step_edge(const VoxelKey& k, const VoxelStats& s) {
+  if (s.count < uint32_t(opt_.n_min)) return false;
+  const Cell* up = rcell({k.x, k.y, k.z + 1});
+  if (!up || !(up->flags & Cell::kObserved) || occupied(up)) return false;  // rays crossed above
+  const double n = s.count, vs = opt_.voxel_size_m;
+  const double sd_z = std::sqrt(std::max(0.0, double(s.m2[5]) / n));
+  const double top = s.mean[2] + std::sqrt(3.0) * sd_z;  // upper end of the points
+  if (top < 0.0) return false;                           // they end in v's lower half
+  const PointPlane own = point_plane(s);
+  if (!steep_sheet(own)) return false;
+  // A step, not a slope: along the sheet's normal one neighbouring column holds no surface
+  // within a step of v's top that is a little higher (a slope rises on), and one holds none
+  // level with it (the step down in front; a tread seen edge-on there reads as none). Heights
+  // from the points' means, so this test reads no other voxel's step-edge flag.
+  const double h = (k.z + 0.5) * vs + std::min(top, 0.5 * vs);
+  const Eigen::Vector2d nh = own.normal.head<2>().normalized();
+  int drop_sides = 0, drop_sign = 0;
+  for (int side = -1; side <= 1; side += 2) {
+    const int32_t cx = k.x + int32_t(std::lround(side * nh.x()));
+    const int32_t cy = k.y + int32_t(std::lround(side * nh.y()));
+    bool level = false;
+    for (int32_t z = k.z - dz_step_ - 1; z <= k.z + dz_step_ + 1; ++z) {
+      const Cell* cw = rcell({cx, cy, z});
+      if (!occupied(cw) || occupied(rcell({cx, cy, z + 1}))) continue;
+      const VoxelStats* sw = cw->stats == Cell::kNoStats ? nullptr : reader_.stats({cx, cy, z});
+      const double hw = (z + 0.5) * vs + (sw && sw->count ? sw->mean[2] : 0.0);
+      if (hw > h + 0.5 * vs && hw <= h + robot_.step_height_m) return false;  // slope up
+      // Level ground beside v: a tread, not another sheet of the same riser (a riser near a
+      // column boundary smears into both columns).
+      if (hw > h - 0.08 && hw <= h + 0.5 * vs)
+        level |= !sw || sw->count < uint32_t(opt_.n_min) || !steep_sheet(point_plane(*sw));
+    }
+    if (!level) ++drop_sides, drop_sign = side;
+  }
+  if (drop_sides == 0) return false;
+  // A riser on a column boundary smears into the columns on both sides. The column in front of
+  // it (its sheet lies on the far side, toward the step up) is mostly the lower ground, not a
+  // nosing.
+  if (drop_sides == 1) {
+    const double d = drop_sign * (s.mean[0] * nh.x() + s.mean[1] * nh.y());  // toward the drop
+    if (d < -0.2 * vs) return false;
+  }
+  return true;
+}
+
 TravState TraversabilityMap::evaluate(const VoxelKey& k, VoxelStats* s) {
   const Cell* c = rcell(k);
   if (!occupied(c)) return TravState::kNone;
@@ -99,7 +166,9 @@ TravState TraversabilityMap::evaluate(const VoxelKey& k, VoxelStats* s) {
         const bool occ = occupied(cw);
         if (occ && !above_occ && cw->stats != Cell::kNoStats) {
           const VoxelStats* sw = reader_.stats(w);
-          if (sw->count && std::abs(surface_height(w, sw) - h_v) <= opt_.neighbourhood_dz_m) {
+          // A step edge's points are its riser, not the surface it stands for.
+          if (sw->count && !(sw->shape & VoxelStats::kStepEdge) &&
+              std::abs(surface_height(w, sw) - h_v) <= opt_.neighbourhood_dz_m) {
             const double n = sw->count;
             const Eigen::Vector3d m(sw->mean[0] + dx * vs, sw->mean[1] + dy * vs,
                                     sw->mean[2] + dz * vs);
@@ -114,44 +183,56 @@ TravState TraversabilityMap::evaluate(const VoxelKey& k, VoxelStats* s) {
         above_occ = occ;
       }
     }
-  const Eigen::Vector3d mean = sum_m / n_agg;
-  const Eigen::Matrix3d cov = sum_s / n_agg - mean * mean.transpose();
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
-  es.computeDirect(cov);
-  const Eigen::Vector3d ev = es.eigenvalues().cwiseMax(0.0);  // ascending l1 <= l2 <= l3
-  // Collinear points (a single scan line on the floor) leave the normal undetermined: not yet
-  // observable, like N(v) < N_min.
-  if (!(ev[2] > 0) || ev[1] < 1e-3 * ev[2]) {
-    s->reasons = VoxelStats::kReasonDegenerate;
-    return TravState::kUnobserved;
-  }
-  const Eigen::Vector3d nrm = es.eigenvectors().col(0);
-  const double slope = std::acos(std::min(1.0, std::abs(nrm.z())));             // s(v), Eq. 1
-  const double rough = 1.0 - (ev[1] - ev[0]) / std::max(1e-18, ev[1] + ev[0]);  // r(v), Eq. 1
-  const double under = 1.0 - std::min(1.0, n_agg / double(opt_.n_ref));         // u(v)
-  // Eq. 2 with s_bar = s / max_slope, r_bar = r, u_bar = u (all 1 at their limits).
-  double cost = opt_.w_s * slope / robot_.max_slope_rad + opt_.w_r * rough + opt_.w_u * under;
-  // Step edges: where the neighbourhood straddles a stair nosing, the pooled points include the
-  // riser below and the plane fit tilts toward vertical, although v's own points are a flat
-  // tread. If v alone holds a well-spread, level plane, its own slope and roughness stand for
-  // it (the riser voxels keep their vertical fit and stay S_untrav).
-  if (cost > opt_.tau_c && s->count >= uint32_t(opt_.n_min)) {
-    const double n = s->count;
-    Eigen::Matrix3d own;
-    own << s->m2[0], s->m2[1], s->m2[2], s->m2[1], s->m2[3], s->m2[4], s->m2[2], s->m2[4], s->m2[5];
-    own /= n;
-    es.computeDirect(own);
-    const Eigen::Vector3d oev = es.eigenvalues().cwiseMax(0.0);
-    if (oev[2] > 0 && oev[1] >= 1e-2 * oev[2]) {  // not collinear
-      const double oslope = std::acos(std::min(1.0, std::abs(es.eigenvectors().col(0).z())));
-      const double orough = 1.0 - (oev[1] - oev[0]) / std::max(1e-18, oev[1] + oev[0]);
-      if (oslope <= 0.5 * robot_.max_slope_rad)
-        cost = std::min(
-            cost, opt_.w_s * oslope / robot_.max_slope_rad + opt_.w_r * orough + opt_.w_u * under);
+  const bool edge = s->shape & VoxelStats::kStepEdge;
+  double cost = 0, nz = 1;
+  if (edge) {
+    // A stair nosing or kerb: the riser's top is observed, the tread behind it inferred (treads
+    // above the sensor are seen edge-on, and a tread on a voxel boundary is grazed free).
+    // Its cost is the under-observation term alone, u(v) = 1; slope and roughness of the
+    // pooled points would be those of the risers around it.
+    cost = opt_.w_u;
+  } else {
+    const Eigen::Vector3d mean = sum_m / n_agg;
+    const Eigen::Matrix3d cov = sum_s / n_agg - mean * mean.transpose();
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
+    es.computeDirect(cov);
+    const Eigen::Vector3d ev = es.eigenvalues().cwiseMax(0.0);  // ascending l1 <= l2 <= l3
+    // Collinear points (a single scan line on the floor) leave the normal undetermined: not yet
+    // observable, like N(v) < N_min.
+    if (!(ev[2] > 0) || ev[1] < 1e-3 * ev[2]) {
+      s->reasons = VoxelStats::kReasonDegenerate;
+      return TravState::kUnobserved;
     }
+    const Eigen::Vector3d nrm = es.eigenvectors().col(0);
+    const double slope = std::acos(std::min(1.0, std::abs(nrm.z())));             // s(v), Eq. 1
+    const double rough = 1.0 - (ev[1] - ev[0]) / std::max(1e-18, ev[1] + ev[0]);  // r(v), Eq. 1
+    const double under = 1.0 - std::min(1.0, n_agg / double(opt_.n_ref));         // u(v)
+    // Eq. 2 with s_bar = s / max_slope, r_bar = r, u_bar = u (all 1 at their limits).
+    cost = opt_.w_s * slope / robot_.max_slope_rad + opt_.w_r * rough + opt_.w_u * under;
+    // Step edges: where the neighbourhood straddles a stair nosing, the pooled points include the
+    // riser below and the plane fit tilts toward vertical, although v's own points are a flat
+    // tread. If v alone holds a well-spread, level plane, its own slope and roughness stand for
+    // it (the riser voxels keep their vertical fit and stay S_untrav).
+    if (cost > opt_.tau_c && s->count >= uint32_t(opt_.n_min) && !edge) {
+      const double n = s->count;
+      Eigen::Matrix3d own;
+      own << s->m2[0], s->m2[1], s->m2[2], s->m2[1], s->m2[3], s->m2[4], s->m2[2], s->m2[4],
+          s->m2[5];
+      own /= n;
+      es.computeDirect(own);
+      const Eigen::Vector3d oev = es.eigenvalues().cwiseMax(0.0);
+      if (oev[2] > 0 && oev[1] >= 1e-2 * oev[2]) {  // not collinear
+        const double oslope = std::acos(std::min(1.0, std::abs(es.eigenvectors().col(0).z())));
+        const double orough = 1.0 - (oev[1] - oev[0]) / std::max(1e-18, oev[1] + oev[0]);
+        if (oslope <= 0.5 * robot_.max_slope_rad)
+          cost = std::min(cost, opt_.w_s * oslope / robot_.max_slope_rad + opt_.w_r * orough +
+                                    opt_.w_u * under);
+      }
+    }
+    nz = std::abs(nrm.z());
   }
   s->cost = float(cost);
-  s->normal_z = float(std::abs(nrm.z()));
+  s->normal_z = float(nz);
   if (cost > opt_.tau_c) s->reasons |= VoxelStats::kReasonCost;
 
   // R_col(v): an occupied voxel whose points lie above the step height and below the body
@@ -169,9 +250,9 @@ TravState TraversabilityMap::evaluate(const VoxelKey& k, VoxelStats* s) {
         const VoxelKey w{k.x + dx, k.y + dy, k.z + dz};
         const Cell* cw = rcell(w);
         if (!occupied(cw)) continue;
-        const double dh =
-            surface_height(w, cw->stats == Cell::kNoStats ? nullptr : reader_.stats(w)) - h_top;
-        hit = dh > robot_.step_height_m && dh <= clear;
+        const VoxelStats* sw = cw->stats == Cell::kNoStats ? nullptr : reader_.stats(w);
+        const double dh = surface_height(w, sw) - h_top;
+        hit = dh > robot_.step_height_m + step_slack(s, sw) && dh <= clear;
       }
       if (hit) {
         s->reasons |= VoxelStats::kReasonCollision;
@@ -182,10 +263,11 @@ TravState TraversabilityMap::evaluate(const VoxelKey& k, VoxelStats* s) {
   // R_fall(v): a neighbour column is a drop if nothing occupied lies from one step below v's
   // surface up to the body clearance (no ground to stand on, and no wall) while the space just
   // below v's level is observed free (v's own level is not evidence: rays graze through the
-  // upper part of floor voxels). Unknown columns are no evidence either way (under-observed
-  // ground is S_unobs territory, not a ledge). Too many drops in the neighbourhood: a ledge.
-  // Heights compared where the feet stand (standing_height, h_top): at a nosing, mean heights
-  // pulled down by riser points read a 0.167 m rise as a drop beyond the 0.18 m step.
+  // upper part of floor voxels) and, further down, free to the lower ground (not unknown). Unknown
+  // columns are no evidence either way (under-observed ground is S_unobs territory, not a ledge).
+  // Too many drops in the neighbourhood: a ledge. Heights compared where the feet stand
+  // (standing_height, h_top): at a nosing, mean heights pulled down by riser points read a 0.167 m
+  // rise as a drop beyond the 0.18 m step.
   int total = 0, drops = 0;
   for (int dx = -r_agg_; dx <= r_agg_; ++dx)
     for (int dy = -r_agg_; dy <= r_agg_; ++dy) {
@@ -204,7 +286,16 @@ TravState TraversabilityMap::evaluate(const VoxelKey& k, VoxelStats* s) {
             standing_height(w, cw->stats == Cell::kNoStats ? nullptr : reader_.stats(w)) - h_top;
         safe = dh >= -robot_.step_height_m && dh <= clear;
       }
-      drops += !safe && seen_free;
+      if (safe || !seen_free) continue;
+      // Free just below v's level, but nothing observed under that: a tread seen edge-on (rays
+      // grazing over it keep its voxel free; the stair's solid under it is never seen), not a
+      // ledge. Under a ledge rays reach the open space or the lower ground.
+      bool drop = false;
+      for (int dz = -dz_step_ - 1; dz >= -3 * dz_step_ && !drop; --dz) {
+        const Cell* cw = rcell({k.x + dx, k.y + dy, k.z + dz});
+        drop = cw && (cw->flags & Cell::kObserved);
+      }
+      drops += drop;
     }
   if (total > 0 && double(drops) > (1.0 - opt_.fall_support_ratio) * double(total))
     s->reasons |= VoxelStats::kReasonFall;

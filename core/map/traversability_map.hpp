@@ -133,20 +133,21 @@ class TraversabilityMap {
     return c && (c->flags & Cell::kObserved) && c->log_odds > occ_q_;
   }
   float surface_height(const VoxelKey& k, const VoxelStats* s) const {
-    return float((k.z + 0.5) * opt_.voxel_size_m) + (s && s->count ? s->mean[2] : 0.0f);
+    return float((k.z + 0.5) * opt_.voxel_size_m) + surface_offset(s, float(opt_.voxel_size_m));
   }
   // Where the feet stand on v: the top of its points, mean + one standard deviation in z
   // (within the voxel). A stair's nosing voxel also holds riser points below the tread that
   // pull the mean down, by about as much as the 1 cm between a 0.167 m rise and the 0.18 m step.
   float standing_height(const VoxelKey& k, const VoxelStats* s) const {
     const float h = surface_height(k, s);
-    if (!s || !s->count) return h;
+    if (!s || !s->count || (s->shape & VoxelStats::kStepEdge)) return h;  // already the top
     const float sd = std::sqrt(std::max(0.0f, s->m2[5] / float(s->count)));
     return std::min(h + sd, float((k.z + 1) * opt_.voxel_size_m));
   }
   void mark_changed(const VoxelKey& k, Cell& c);
-  TravState evaluate(const VoxelKey& k, VoxelStats* s);  // Eq. 1-3 for one voxel
-  bool connected(const VoxelKey& a, const VoxelKey& b);  // C_reach adjacency
+  TravState evaluate(const VoxelKey& k, VoxelStats* s);    // Eq. 1-3 for one voxel
+  bool step_edge(const VoxelKey& k, const VoxelStats& s);  // VoxelStats::kStepEdge test
+  bool connected(const VoxelKey& a, const VoxelKey& b);    // C_reach adjacency
   bool has_parent(const VoxelKey& k, uint32_t dist);
   void set_reachable(const VoxelKey& k, uint32_t dist);
   void clear_reachable(const VoxelKey& k);

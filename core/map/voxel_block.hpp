@@ -1,5 +1,7 @@
 #pragma once
 // Packed voxel cells and 8^3 voxel blocks of the sparse map (Bonxai-style, paper Sec. III-A).
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -65,12 +67,18 @@ struct VoxelStats {
   float normal_z = 1;                // |n_v . e_z| of the aggregated normal
   uint32_t reach_dist = 0;           // hop count from the C_reach root (decremental BFS invariant)
   uint8_t reasons = 0;  // why tau(v) is not S_trav: kReason* bits (diagnostics, export)
+  uint8_t shape = 0;    // kStepEdge: set with tau(v) from v's own points and the voxel above
 
   static constexpr uint8_t kReasonNotTop = 1;      // voxel above is occupied (not a surface)
   static constexpr uint8_t kReasonDegenerate = 2;  // neighbourhood points are collinear
   static constexpr uint8_t kReasonCost = 4;        // c(v) > tau_c
   static constexpr uint8_t kReasonCollision = 8;   // R_col(v)
   static constexpr uint8_t kReasonFall = 16;       // R_fall(v)
+
+  // A step edge: v's own points are a steep sheet reaching v's upper half under observed free
+  // space: the riser of a step whose tread lies at the sheet's top (a stair nosing, a kerb). A
+  // tread on a voxel boundary leaves only the riser's top in the column behind the nosing.
+  static constexpr uint8_t kStepEdge = 1;
 
   void add(float px, float py, float pz) {
     ++count;
@@ -89,6 +97,26 @@ struct VoxelStats {
   }
   void reset() { *this = VoxelStats{}; }
 };
+
+// Height of v's surface relative to its centre: the points' mean, or for a step edge the top
+// of its riser (mean + sqrt(3) sd: the upper end of points spread evenly over the riser's
+// height), within the voxel.
+inline float surface_offset(const VoxelStats* s, float voxel_size) {
+  if (!s || !s->count) return 0.0f;
+  if (!(s->shape & VoxelStats::kStepEdge)) return s->mean[2];
+  const float sd = std::sqrt(std::max(0.0f, s->m2[5] / float(s->count)));
+  return std::min(s->mean[2] + 1.7320508f * sd, 0.5f * voxel_size);
+}
+
+// A step edge's height is an estimate from moments: with a strip of tread on top of its riser
+// the points are not spread evenly and mean + sqrt(3) sd lands up to ~2 cm above the tread.
+// Step-height comparisons involving a step edge allow this much more.
+inline constexpr float kStepEdgeSlackM = 0.025f;
+inline float step_slack(const VoxelStats* a, const VoxelStats* b = nullptr) {
+  const bool edge =
+      (a && (a->shape & VoxelStats::kStepEdge)) || (b && (b->shape & VoxelStats::kStepEdge));
+  return edge ? kStepEdgeSlackM : 0.0f;
+}
 
 // 8^3 cells plus the statistics of the occupied ones. Copied as a whole on copy-on-write.
 struct VoxelBlock {

@@ -183,8 +183,12 @@ bool LocalPlanner::can_turn(const map::MapView& view, const Eigen::Vector3d& foo
 
 // A straight step at constant yaw (the legs walk sideways or backwards as well) to the nearest
 // pose within escape_turn_radius_m where the body can turn on the spot.
-bool LocalPlanner::escape(const LocalPlanInput& in, LocalPlanResult& out) {
-  if (can_turn(*in.view, start_foot_m_, start_yaw_)) return false;
+bool LocalPlanner::escape(const LocalPlanInput& in, LocalPlanResult& out,
+                          const Eigen::Vector3f* away_from) {
+  if (!away_from && can_turn(*in.view, start_foot_m_, start_yaw_)) return false;
+  auto dist_xy = [&](const Eigen::Vector3d& p) {
+    return (p.head<2>() - away_from->head<2>().cast<double>()).norm();
+  };
   constexpr int kDirs = 16;
   const double spacing = 0.1;
   for (double d = 0.1; d <= opt_.escape_turn_radius_m + 1e-9; d += 0.1)
@@ -193,6 +197,7 @@ bool LocalPlanner::escape(const LocalPlanInput& in, LocalPlanResult& out) {
       Eigen::Vector3d b = start_foot_m_ + Eigen::Vector3d(d * std::cos(th), d * std::sin(th), 0);
       const auto s = in.view->support_surface_near(b.cast<float>(), robot_.step_height_m);
       if (!s || !s->reachable) continue;
+      if (away_from && dist_xy(b) < dist_xy(start_foot_m_) + 0.5 * d) continue;
       b.z() = s->height_m;
       if (!can_turn(*in.view, b, start_yaw_)) continue;
       std::vector<Eigen::Vector3d> c(3, start_foot_m_);
@@ -502,6 +507,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
          ++k, ++attempts)
       ok = try_target(in, vps[k], out, &why);
     if (ok) {
+      start_escapes_ = 0;
       has_target_ = true;
       target_cluster_ = c.cluster_id;
       target_m_ = out.target_m;
@@ -523,6 +529,30 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     current_ = out.trajectory;
     planned_at_s_ = in.t_s;
     out.replan_reason = "escape: cannot turn here";
+    out.status = LocalPlanStatus::kNewTrajectory;
+    return out;
+  }
+  // Every attempt's body hit an obstacle next to the start: the start is boxed in (it faces a
+  // wall, or stands by a wall end it cannot curve away from), not the clusters: step away from
+  // the nearest of those obstacles and plan again from there.
+  bool boxed_in = !failed.empty();
+  Eigen::Vector3f hit = kNoHitM;
+  double hit_d = std::numeric_limits<double>::infinity();
+  for (const Failed& f : failed) {
+    const double d = std::isnan(f.hit_m.x())
+                         ? std::numeric_limits<double>::infinity()
+                         : (f.hit_m.head<2>().cast<double>() - start_foot_m_.head<2>()).norm();
+    boxed_in = boxed_in && d <= opt_.start_blame_radius_m;
+    if (d < hit_d) hit_d = d, hit = f.hit_m;
+  }
+  if (boxed_in && start_escapes_ < opt_.max_start_escapes && escape(in, out, &hit)) {
+    ++start_escapes_;
+    has_target_ = true;
+    target_cluster_ = -1;
+    target_m_ = out.target_m;
+    current_ = out.trajectory;
+    planned_at_s_ = in.t_s;
+    out.replan_reason = "escape: boxed in by an obstacle next to the start";
     out.status = LocalPlanStatus::kNewTrajectory;
     return out;
   }

@@ -114,6 +114,9 @@ struct LocalPlannerOptions {
   int max_stage3_attempts = 6;           // viewpoints tried per cycle (bounded work)
   double escape_radius_m = 0.3;          // start pose in collision: free start searched this far
   double escape_turn_radius_m = 0.8;     // cannot turn on the spot: a turning place this far
+  double start_blame_radius_m = 0.7;     // every try hits an obstacle this close to the start:
+                                         // the start is boxed in, not the clusters (escape)
+  int max_start_escapes = 3;             // ... at most this many escapes in a row
   double set_aside_expiry_s = 30.0;      // a set-aside node may expire after this [s] ...
   double set_aside_expiry_move_m = 2.0;  // ... once the robot is this far from where it was
 };
@@ -149,7 +152,10 @@ class LocalPlanner {
   // Stage 3 to one viewpoint; on failure *why says A* or trajectory.
   bool free_start(const LocalPlanInput& in);
   bool can_turn(const map::MapView& view, const Eigen::Vector3d& foot, double yaw);
-  bool escape(const LocalPlanInput& in, LocalPlanResult& out);
+  // away_from: the start is boxed in by this obstacle: move away from it even if the body can
+  // turn where it stands.
+  bool escape(const LocalPlanInput& in, LocalPlanResult& out,
+              const Eigen::Vector3f* away_from = nullptr);
   bool try_target(const LocalPlanInput& in, const Viewpoint& vp, LocalPlanResult& out,
                   SetAsideReason* why);
 
@@ -183,6 +189,7 @@ class LocalPlanner {
   std::vector<graph::NodeId> near_scratch_;
   std::vector<std::pair<int32_t, int>> failures_;
   Eigen::Vector3f last_hit_m_ = kNoHitM;  // try_target: where the last B-spline collided
+  int start_escapes_ = 0;                 // escapes from a boxed-in start since the last target
   std::vector<int32_t>
       approached_;  // clusters whose viewpoint was reached once (walk onto them next)
 };

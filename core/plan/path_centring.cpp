@@ -171,6 +171,33 @@ std::optional<FlightAxis> flight_axis(const map::MapView& view, const Eigen::Vec
   FlightAxis a;
   a.dir = sum.normalized();
   a.origin = foot.head<2>();
+  // The risers face along the axis: where the map holds step edges ahead (their points are the
+  // risers), the mean of their normals is the axis. The height gains above are only a first
+  // guess: a side of the flight seen less well biases them toward the other side wall.
+  {
+    const double s = view.voxel_size_m();
+    const Eigen::Vector2d nrm(-a.dir.y(), a.dir.x());
+    const double z_lo = sign > 0 ? foot.z() - s : foot.z() - 1.0;
+    const double z_hi = sign > 0 ? foot.z() + 1.0 : foot.z() + s;
+    Eigen::Vector2d risers = Eigen::Vector2d::Zero();
+    int n = 0;
+    for (double t = 0.0; t <= 1.2; t += s)
+      for (double l = -0.6; l <= 0.6; l += s) {
+        const Eigen::Vector2d q = foot.head<2>() + t * a.dir + l * nrm;
+        const int32_t cx = int32_t(std::floor(q.x() / s)), cy = int32_t(std::floor(q.y() / s));
+        for (int32_t cz = int32_t(std::floor(z_lo / s)); cz <= int32_t(std::floor(z_hi / s));
+             ++cz) {
+          const auto rn = view.riser_normal({cx, cy, cz});
+          if (!rn) continue;
+          Eigen::Vector2d d = rn->cast<double>();
+          if (d.dot(a.dir) < 0) d = -d;
+          if (d.dot(a.dir) < std::cos(M_PI / 4)) continue;  // a side wall's top, not a riser
+          risers += d;
+          ++n;
+        }
+      }
+    if (n >= 4) a.dir = risers.normalized();
+  }
   // Centre the axis between the flight's side walls, measured 0.6 m up the flight at the
   // level of the support there.
   const RobotModel& r = view.robot();

@@ -7,6 +7,14 @@
 namespace storey::core::plan {
 
 namespace {
+// A stair nosing's height (a step edge) reads up to kStepEdgeSlackM high: the next nosing one
+// rise up must not read as an obstacle above the step height.
+float edge_slack(const map::MapView& view, const map::VoxelKey& k) {
+  return view.is_step_edge(k) ? map::kStepEdgeSlackM : 0.0f;
+}
+}  // namespace
+
+namespace {
 uint64_t pack(const map::VoxelKey& k) {
   constexpr uint64_t m = (uint64_t{1} << 21) - 1;
   return ((uint64_t(uint32_t(k.x)) & m) << 42) | ((uint64_t(uint32_t(k.y)) & m) << 21) |
@@ -53,8 +61,9 @@ bool VoxelAStar::passable(const map::MapView& view, const map::VoxelKey& k, floa
     for (int dy = -rv; dy <= rv; ++dy) {
       if ((dx * dx + dy * dy) * s * s > r * r + 1e-12) continue;
       for (int32_t z = kz0; z <= kz1; ++z) {
-        const auto zs = view.surface_height_m({k.x + dx, k.y + dy, z});
-        if (zs && *zs >= z_lo && *zs < z_hi) return false;
+        const map::VoxelKey w{k.x + dx, k.y + dy, z};
+        const auto zs = view.surface_height_m(w);
+        if (zs && *zs - edge_slack(view, w) >= z_lo && *zs < z_hi) return false;
       }
     }
   return true;
@@ -80,7 +89,7 @@ bool VoxelAStar::near_obstacle(const map::MapView& view, const map::VoxelKey& k,
       const int32_t y = int32_t(std::floor((c.y() + r * std::sin(th)) / s));
       for (int32_t z = kz0; z <= kz1; ++z) {
         const auto zs = view.surface_height_m({x, y, z});
-        if (zs && *zs >= z_lo && *zs < z_hi) return true;
+        if (zs && *zs - edge_slack(view, {x, y, z}) >= z_lo && *zs < z_hi) return true;
       }
     }
   }
@@ -90,7 +99,8 @@ bool VoxelAStar::near_obstacle(const map::MapView& view, const map::VoxelKey& k,
 uint32_t VoxelAStar::neighbour(const map::MapView& view, int32_t x, int32_t y, float h) {
   const double s = view.voxel_size_m();
   const Eigen::Vector3f p(float((x + 0.5) * s), float((y + 0.5) * s), h);
-  const auto sp = view.support_surface_near(p, view.robot().step_height_m);
+  // Window widened by the step-edge slack; the step itself is checked in plan().
+  const auto sp = view.support_surface_near(p, view.robot().step_height_m + map::kStepEdgeSlackM);
   if (!sp) return kNone;
   const uint64_t key = pack(sp->key);
   auto [it, fresh] = passable_.try_emplace(key, 0);
@@ -177,7 +187,10 @@ VoxelPath VoxelAStar::plan(const map::MapView& view, const Eigen::Vector3d& star
       Node& n = nodes_[nb];
       if (n.closed) continue;
       const Eigen::Vector3d np = point(n);
-      if (std::abs(np.z() - cp.z()) > step) continue;
+      // Nosing heights (step edges) are estimates up to kStepEdgeSlackM high.
+      if (std::abs(np.z() - cp.z()) >
+          step + std::max(edge_slack(view, n.key), edge_slack(view, cur.key)))
+        continue;
       goal_seen_passable |= at_goal(np);
       const double w = (np - cp).norm() * (1.0 + opt_.cost_weight * view.cost(n.key) +
                                            (n.near ? opt_.clearance_weight : 0.0));

@@ -164,3 +164,30 @@ TEST(ReachableSet, IncrementalEqualsFromScratchUnderRandomUpdates) {
   EXPECT_GT(largest, 3000u);
   EXPECT_GT(shrinks, 0);  // the decremental path was exercised
 }
+
+// C_reach strides over one column up or down a step (a stair tread the LiDAR saw edge-on, its
+// voxels grazed free), but not over a hole in level ground, nor over anything standing in it.
+TEST(ReachableSet, StridesOverAnUnseenStripOnlyUpOrDownAStep) {
+  auto reaches_far_patch = [](float far_z, bool wall) {
+    TraversabilityMap m;
+    std::vector<Vector3f> pts;
+    for (float y = -0.5f; y <= 0.5f; y += 0.02f) {
+      for (float x = -1.0f; x < 0.49f; x += 0.02f) pts.emplace_back(x, y, 0.02f);
+      for (float x = 0.61f; x < 1.5f; x += 0.02f) pts.emplace_back(x, y, far_z);
+      if (wall)
+        for (float z = 0.05f; z < 0.8f; z += 0.02f) pts.emplace_back(0.55f, y, z);
+    }
+    for (int rep = 0; rep < 4; ++rep) m.insert_scan(Vector3f(0.0f, 0.0f, 1.0f), pts);
+    m.update_traversability();
+    m.update_reachable(Vector3f(0.0f, 0.0f, 0.02f));
+    const MapView v = m.view();
+    EXPECT_TRUE(v.is_reachable(v.key_of(Vector3f(0.2f, 0.05f, 0.01f))));
+    const VoxelKey far = v.key_of(Vector3f(1.0f, 0.05f, far_z - 0.01f));
+    EXPECT_EQ(v.state(far), TravState::kTraversable);
+    EXPECT_EQ(flagged_reachable(m), scratch_reachable(m));
+    return v.is_reachable(far);
+  };
+  EXPECT_TRUE(reaches_far_patch(0.17f, false)) << "no stride up a 0.15 m step";
+  EXPECT_FALSE(reaches_far_patch(0.02f, false)) << "a hole in level ground was bridged";
+  EXPECT_FALSE(reaches_far_patch(0.17f, true)) << "strode through a wall";
+}

@@ -255,7 +255,65 @@ TEST(Terrain, FlatTreadNextToARiserKeepsItsOwnLevelPlane) {
   ASSERT_TRUE(s.has_value());
   EXPECT_NEAR(s->height_m, 0.505f, 0.02f);
   EXPECT_EQ(s->state, TravState::kTraversable);
-  // The riser's own voxels stay untraversable (vertical points, or not a top surface).
+  // The riser's own column ([0.2, 0.3): its sheet at the far edge, the tread behind it seen) is
+  // mostly the lower tread: not a step edge, and its riser voxels stay untraversable.
   const auto r = v.support_surface_near(Vector3f(0.25f, 0.05f, 0.45f), 0.05);
   if (r) EXPECT_NE(r->state, TravState::kTraversable);
+}
+
+TEST(Terrain, RiserSmearBehindANosingStandsForTheTread) {
+  // A riser at x = 0.295 from z 0.34 to a tread at exactly 0.5 (a voxel boundary), its points
+  // smeared +-2 cm in x by range noise, the tread itself never hit (seen edge-on), rays grazing
+  // over it to a wall beyond. The column behind the nosing, [0.3, 0.4), holds only the riser's
+  // smear: a step edge standing for the tread at 0.5, traversable; the one in front is a step
+  // edge too (its top is the nosing).
+  TraversabilityMap m;
+  std::vector<Vector3f> pts;
+  int j = 0;
+  for (float y = -0.3f; y <= 0.3f; y += 0.02f) {
+    for (float z = 0.345f; z < 0.5f; z += 0.005f, ++j)
+      pts.emplace_back(0.295f + 0.02f * float((j * 7919) % 201 - 100) / 100.0f, y, z);  // riser
+    for (float x = 0.02f; x < 0.27f; x += 0.05f) pts.emplace_back(x, y, 0.338f);  // lower tread
+    for (float z = 0.51f; z < 0.6f; z += 0.02f) pts.emplace_back(1.5f, y, z);     // wall beyond
+  }
+  for (int rep = 0; rep < 3; ++rep) m.insert_scan(Vector3f(-0.8f, 0, 0.6f), pts);
+  m.update_traversability();
+  const MapView v = m.view();
+  BlockReader rd(v.store());
+  const VoxelKey behind{3, 0, 4};  // x [0.3, 0.4), y [0, 0.1), z [0.4, 0.5)
+  ASSERT_EQ(v.occupancy(behind), Occupancy::kOccupied);
+  ASSERT_NE(rd.stats(behind), nullptr);
+  EXPECT_TRUE(rd.stats(behind)->shape & VoxelStats::kStepEdge);
+  EXPECT_EQ(v.state(behind), TravState::kTraversable);
+  ASSERT_TRUE(v.surface_height_m(behind).has_value());
+  EXPECT_NEAR(*v.surface_height_m(behind), 0.5f, 0.02f);
+  // The lower tread, 0.16 below the nosing (within the step: C_reach climbs on).
+  const VoxelKey lower{1, 0, 3};  // the lower tread, x [0.1, 0.2), z [0.3, 0.4)
+  EXPECT_EQ(v.state(lower), TravState::kTraversable);
+}
+
+TEST(Terrain, SteepSlopeTopIsNotAStepEdge) {
+  // A 50 deg slope's top voxels hold tilted sheets under free space like a riser's, but the
+  // next column up rises by ~0.12 m: a slope, never a step edge, never traversable.
+  TraversabilityMap m;
+  std::vector<Vector3f> pts;
+  const float t = std::tan(50.0f * float(M_PI) / 180.0f);
+  for (float y = -0.5f; y <= 0.5f; y += 0.02f)
+    for (float x = 0.0f; x < 1.0f; x += 0.01f) pts.emplace_back(x, y, 0.03f + x * t);
+  for (int rep = 0; rep < 3; ++rep) m.insert_scan(Vector3f(-1.5f, 0, 0.6f), pts);
+  m.update_traversability();
+  const MapView v = m.view();
+  BlockReader rd(v.store());
+  int edges = 0, trav = 0, found = 0;
+  for (float x = 0.15f; x < 0.9f; x += 0.1f) {
+    const auto s = v.support_surface_near(Vector3f(x, 0.05f, 0.03f + x * t), 0.1);
+    if (!s) continue;
+    ++found;
+    const VoxelStats* st = rd.stats(s->key);
+    edges += st && (st->shape & VoxelStats::kStepEdge);
+    trav += s->state == TravState::kTraversable;
+  }
+  EXPECT_GE(found, 5);
+  EXPECT_EQ(edges, 0);
+  EXPECT_EQ(trav, 0);
 }

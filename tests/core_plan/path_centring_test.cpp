@@ -108,6 +108,8 @@ TEST(PathCentring, FlightIsWalkedOnItsAxisAfterARunUp) {
                                 {-0.2, 0.5, 0},   {-0.1, 0.4, 0},   {0.1, 0.4, 0.15},
                                 {0.4, 0.35, 0.3}, {0.7, 0.3, 0.45}, {1.0, 0.3, 0.6}};
   const FlightShaping f = shape_flights(view, path);
+  if (getenv("STOREY_DEBUG"))
+    for (const Vector3d& q : path) printf("  %.3f %.3f %.3f\n", q.x(), q.y(), q.z());
   ASSERT_EQ(f.flights, 1) << f.no_axis << " " << f.no_run_up;
   EXPECT_TRUE(f.end_on_flight);
   EXPECT_NEAR(f.end_yaw_rad, 0.0, 0.2);

@@ -12,7 +12,7 @@ TEST(ExploreRamp, ReachesAndExploresTheUpperFloorSafely) {
   SimRunOptions o;
   o.scene = "test_ramp";
   o.seed = 1;
-  o.time_limit_s = 360;
+  o.time_limit_s = 600;
   o.progress_period_s = 0;
   o.progress = [](const std::string&) {};
   const SimRunResult r = run_exploration(o);
@@ -21,10 +21,12 @@ TEST(ExploreRamp, ReachesAndExploresTheUpperFloorSafely) {
   EXPECT_EQ(m.falls, 0u);
   ASSERT_EQ(m.floors_total, 2);
   ASSERT_EQ(m.per_floor.size(), 2u);
-  // Measured 0.90 / 0.70 at 360 s (seed 1); before ramps were centred like level ground the
-  // robot never left floor 0 (every trajectory up the ramp touched its side wall).
+  // Measured 0.893 / 0.900 at 600 s (seed 1). Since stair nosings are step edges (session 5)
+  // the robot takes the ramp before floor 0 is done and comes back for it: at 360 s floor 0
+  // stood at 0.40, floor 1 at 0.91 (before: 0.87 / 0.73, floor 0 first). Before ramps were
+  // centred like level ground the robot never left floor 0.
   EXPECT_GE(m.per_floor[0].traversable_coverage, 0.8);
-  EXPECT_GE(m.per_floor[1].traversable_coverage, 0.5) << "the upper floor was not explored";
+  EXPECT_GE(m.per_floor[1].traversable_coverage, 0.75) << "the upper floor was not explored";
 }
 
 }  // namespace
