@@ -183,31 +183,6 @@ bool LocalPlanner::can_turn(const map::MapView& view, const Eigen::Vector3d& foo
 
 // A straight step at constant yaw (the legs walk sideways or backwards as well) to the nearest
 // pose within escape_turn_radius_m where the body can turn on the spot.
-bool LocalPlanner::turn_to(const LocalPlanInput& in, LocalPlanResult& out, double target) {
-  if (!std::isfinite(target)) return false;
-  const double dyaw = std::remainder(target - start_yaw_, 2.0 * M_PI);
-  if (std::abs(dyaw) < 0.3) return false;  // already facing it: turning is not the remedy
-  const int n = std::max(2, int(std::ceil(std::abs(dyaw) / 0.3)));
-  std::vector<Eigen::Vector3d> c(size_t(n) + 5, start_foot_m_);
-  std::vector<double> yaw(c.size(), start_yaw_);
-  for (size_t j = 0; j < yaw.size(); ++j)
-    yaw[j] = start_yaw_ + dyaw * std::clamp((double(j) - 2.0) / n, 0.0, 1.0);
-  // Knot interval: half the yaw rate limit.
-  const double dt = std::abs(dyaw) / n / (0.5 * std::max(robot_.max_yaw_rate_rps, 1e-3));
-  BsplineTrajectory t(std::move(c), std::move(yaw), dt, in.t_s);
-  if (checker_
-          .check_ahead(
-              *in.view, [&](double tt) { return t.pose(tt); }, t.t_start(), t.duration(), 0.0)
-          .collides)
-    return false;
-  out.trajectory = std::move(t);
-  out.path_m = {start_foot_m_, start_foot_m_};
-  out.target_m = start_foot_m_;
-  out.target_yaw_rad = target;
-  out.real_until_s = out.trajectory.t_end();
-  return true;
-}
-
 bool LocalPlanner::escape(const LocalPlanInput& in, LocalPlanResult& out,
                           const Eigen::Vector3f* away_from) {
   if (!away_from && can_turn(*in.view, start_foot_m_, start_yaw_)) return false;
@@ -222,7 +197,7 @@ bool LocalPlanner::escape(const LocalPlanInput& in, LocalPlanResult& out,
       Eigen::Vector3d b = start_foot_m_ + Eigen::Vector3d(d * std::cos(th), d * std::sin(th), 0);
       const auto s = in.view->support_surface_near(b.cast<float>(), robot_.step_height_m);
       if (!s || !s->reachable) continue;
-      if (away_from && dist_xy(b) < dist_xy(start_foot_m_) + 0.05) continue;
+      if (away_from && dist_xy(b) < dist_xy(start_foot_m_) + 0.5 * d) continue;
       b.z() = s->height_m;
       if (!can_turn(*in.view, b, start_yaw_)) continue;
       std::vector<Eigen::Vector3d> c(3, start_foot_m_);
@@ -291,13 +266,6 @@ bool LocalPlanner::try_target(const LocalPlanInput& in, const Viewpoint& vp, Loc
   double goal_yaw = shape_path(*in.view, path.points_m, vp.yaw_rad);
   TrajectoryResult tr =
       builder_.build(*in.view, checker_, path.points_m, start_yaw_, goal_yaw, in.t_s);
-  // The heading the path leaves the start in (0.6 m out): a boxed-in start turns to it first.
-  last_path_yaw_ = NAN;
-  for (const Eigen::Vector3d& q : path.points_m)
-    if ((q - start_foot_m_).head<2>().norm() >= 0.6) {
-      last_path_yaw_ = std::atan2(q.y() - start_foot_m_.y(), q.x() - start_foot_m_.x());
-      break;
-    }
   auto failed = [&]() {
     if (tr.hit.collides) last_hit_m_ = tr.hit.voxel_m.cast<float>();
     return tr.status != TrajectoryStatus::kOk && tr.status != TrajectoryStatus::kPolyline;
@@ -329,18 +297,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   // ---- Keep the current target unless there is a reason to replan.
   probe_mark(probe_, PlanStage::kLocalKeep);
   const char* reason = "no target";
-  if (has_target_ && target_cluster_ < 0) {
-    // An escape (a step or a turn on the spot, no cluster): run it to its end, then replan.
-    if (in.t_s < current_.t_end()) {
-      out.status = LocalPlanStatus::kKeep;
-      out.target_cluster = -1;
-      out.target_m = target_m_;
-      out.real_until_s = current_.t_end();
-      return out;
-    }
-    reason = "escape done";
-    has_target_ = false;
-  } else if (has_target_) {
+  if (has_target_) {
     const graph::FrontierCluster* tc = find_cluster(in, target_cluster_);
     const double dxy = (in.robot_foot_m - target_m_).head<2>().norm();
     const bool reached =
@@ -537,7 +494,6 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     size_t m;  // index into order
     SetAsideReason why;
     Eigen::Vector3f hit_m;
-    double path_yaw;  // heading the attempt's path left the start in (NaN: none)
   };
   std::vector<Failed> failed;
   for (size_t m = 0; m < order.size() && attempts < opt_.max_stage3_attempts; ++m) {
@@ -561,7 +517,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
       out.status = LocalPlanStatus::kNewTrajectory;
       return out;
     }
-    failed.push_back({m, why, last_hit_m_, last_path_yaw_});
+    failed.push_back({m, why, last_hit_m_});
   }
   // Every attempt failed. If the robot cannot turn where it stands (a dead end narrower than
   // the body's turning circle: every path back starts with a turn), the clusters are not to
@@ -581,19 +537,15 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   // the nearest of those obstacles and plan again from there.
   bool boxed_in = !failed.empty();
   Eigen::Vector3f hit = kNoHitM;
-  double hit_d = std::numeric_limits<double>::infinity(), path_yaw = NAN;
+  double hit_d = std::numeric_limits<double>::infinity();
   for (const Failed& f : failed) {
-    if (std::isnan(path_yaw)) path_yaw = f.path_yaw;
     const double d = std::isnan(f.hit_m.x())
                          ? std::numeric_limits<double>::infinity()
                          : (f.hit_m.head<2>().cast<double>() - start_foot_m_.head<2>()).norm();
     boxed_in = boxed_in && d <= opt_.start_blame_radius_m;
     if (d < hit_d) hit_d = d, hit = f.hit_m;
   }
-  // First turn on the spot to the heading the path leaves in (the B-spline turns while it
-  // moves, which swings the body's ends into the obstacle), else step away to where it can turn.
-  if (boxed_in && start_escapes_ < opt_.max_start_escapes &&
-      (turn_to(in, out, path_yaw) || escape(in, out, &hit))) {
+  if (boxed_in && start_escapes_ < opt_.max_start_escapes && escape(in, out, &hit)) {
     ++start_escapes_;
     has_target_ = true;
     target_cluster_ = -1;
@@ -605,7 +557,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     return out;
   }
   // Stage 3 failed for these clusters: after max_failures cycles a cluster is set aside.
-  for (const auto& [m, why, hit_m, unused_yaw] : failed) {
+  for (const auto& [m, why, hit_m] : failed) {
     const Candidate& c = sel[order[m]];
     auto it = std::find_if(failures_.begin(), failures_.end(),
                            [&](const auto& f) { return f.first == c.cluster_id; });

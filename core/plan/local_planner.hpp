@@ -114,7 +114,7 @@ struct LocalPlannerOptions {
   int max_stage3_attempts = 6;           // viewpoints tried per cycle (bounded work)
   double escape_radius_m = 0.3;          // start pose in collision: free start searched this far
   double escape_turn_radius_m = 0.8;     // cannot turn on the spot: a turning place this far
-  double start_blame_radius_m = 1.0;     // every try hits an obstacle this close to the start:
+  double start_blame_radius_m = 0.7;     // every try hits an obstacle this close to the start:
                                          // the start is boxed in, not the clusters (escape)
   int max_start_escapes = 3;             // ... at most this many escapes in a row
   double set_aside_expiry_s = 30.0;      // a set-aside node may expire after this [s] ...
@@ -152,9 +152,6 @@ class LocalPlanner {
   // Stage 3 to one viewpoint; on failure *why says A* or trajectory.
   bool free_start(const LocalPlanInput& in);
   bool can_turn(const map::MapView& view, const Eigen::Vector3d& foot, double yaw);
-  // A turn on the spot to `yaw` (collision-checked); false if already facing within 0.3 rad of
-  // it, or the turn collides.
-  bool turn_to(const LocalPlanInput& in, LocalPlanResult& out, double yaw);
   // away_from: the start is boxed in by this obstacle: move away from it even if the body can
   // turn where it stands.
   bool escape(const LocalPlanInput& in, LocalPlanResult& out,
@@ -193,7 +190,6 @@ class LocalPlanner {
   std::vector<std::pair<int32_t, int>> failures_;
   Eigen::Vector3f last_hit_m_ = kNoHitM;  // try_target: where the last B-spline collided
   int start_escapes_ = 0;                 // escapes from a boxed-in start since the last target
-  double last_path_yaw_ = 0;              // try_target: heading its path left the start in
   std::vector<int32_t>
       approached_;  // clusters whose viewpoint was reached once (walk onto them next)
 };

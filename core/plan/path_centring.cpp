@@ -173,26 +173,25 @@ std::optional<FlightAxis> flight_axis(const map::MapView& view, const Eigen::Vec
   a.origin = foot.head<2>();
   // The risers face along the axis: where the map holds step edges ahead (their points are the
   // risers), the mean of their normals is the axis. The height gains above are only a first
-  // guess: a side of the flight seen less well biases them toward a side wall, whose top reads
-  // as a surface. Only step edges near the flight's 30 deg line along the path's own direction
-  // count (holes in a side wall's map leave sheet voxels under free space too).
+  // guess: a side of the flight seen less well biases them toward the other side wall.
   {
     const double s = view.voxel_size_m();
-    const Eigen::Vector2d nrm(-hint.y(), hint.x());
+    const Eigen::Vector2d nrm(-a.dir.y(), a.dir.x());
+    const double z_lo = sign > 0 ? foot.z() - s : foot.z() - 1.0;
+    const double z_hi = sign > 0 ? foot.z() + 1.0 : foot.z() + s;
     Eigen::Vector2d risers = Eigen::Vector2d::Zero();
     int n = 0;
     for (double t = 0.0; t <= 1.2; t += s)
       for (double l = -0.6; l <= 0.6; l += s) {
-        const Eigen::Vector2d q = foot.head<2>() + t * hint + l * nrm;
+        const Eigen::Vector2d q = foot.head<2>() + t * a.dir + l * nrm;
         const int32_t cx = int32_t(std::floor(q.x() / s)), cy = int32_t(std::floor(q.y() / s));
-        const double z_line = foot.z() + sign * t * 0.58;
-        for (int32_t cz = int32_t(std::floor((z_line - 0.2) / s));
-             cz <= int32_t(std::floor((z_line + 0.2) / s)); ++cz) {
+        for (int32_t cz = int32_t(std::floor(z_lo / s)); cz <= int32_t(std::floor(z_hi / s));
+             ++cz) {
           const auto rn = view.riser_normal({cx, cy, cz});
           if (!rn) continue;
           Eigen::Vector2d d = rn->cast<double>();
-          if (d.dot(hint) < 0) d = -d;
-          if (d.dot(hint) < std::cos(M_PI / 4)) continue;  // a side wall, not a riser
+          if (d.dot(a.dir) < 0) d = -d;
+          if (d.dot(a.dir) < std::cos(M_PI / 4)) continue;  // a side wall's top, not a riser
           risers += d;
           ++n;
         }
@@ -268,15 +267,8 @@ FlightShaping shape_flights(const map::MapView& view, std::vector<Eigen::Vector3
     };
     const Eigen::Vector2d foot2 = on_axis(points[j].head<2>());
     const Eigen::Vector2d ru2 = foot2 - run_up * axis->dir;
-    // The path's foot point may already stand on the first tread (graph nodes are sparse): the
-    // run-up is then one step lower (or higher, going down).
-    auto ru_sp = view.support_surface_near(
+    const auto ru_sp = view.support_surface_near(
         Eigen::Vector3f(float(ru2.x()), float(ru2.y()), float(points[j].z())), level);
-    if (!ru_sp)
-      ru_sp =
-          view.support_surface_near(Eigen::Vector3f(float(ru2.x()), float(ru2.y()),
-                                                    float(points[j].z() - sign * r.step_height_m)),
-                                    level);
     if (!ru_sp || !(ru_sp->reachable || ru_sp->state == map::TravState::kTraversable) ||
         !clear_disc(view, ru2, ru_sp->height_m, half_w)) {
       ++out.no_run_up;
