@@ -92,10 +92,9 @@ bool TraversabilityMap::step_edge(const VoxelKey& k, const VoxelStats& s) {
   if (s.count < uint32_t(opt_.n_min)) return false;
   const Cell* up = rcell({k.x, k.y, k.z + 1});
   if (!up || !(up->flags & Cell::kObserved) || occupied(up)) return false;  // rays crossed above
-  const double n = s.count, vs = opt_.voxel_size_m;
-  const double sd_z = std::sqrt(std::max(0.0, double(s.m2[5]) / n));
-  const double top = s.mean[2] + std::sqrt(3.0) * sd_z;  // upper end of the points
-  if (top < 0.0) return false;                           // they end in v's lower half
+  const double vs = opt_.voxel_size_m;
+  const double top = sheet_top_offset(s);  // upper end of the points
+  if (top < 0.0) return false;             // they end in v's lower half
   const PointPlane own = point_plane(s);
   if (!steep_sheet(own)) return false;
   // A step, not a slope: along the sheet's normal one neighbouring column holds no surface
@@ -213,16 +212,11 @@ TravState TraversabilityMap::evaluate(const VoxelKey& k, VoxelStats* s) {
     // riser below and the plane fit tilts toward vertical, although v's own points are a flat
     // tread. If v alone holds a well-spread, level plane, its own slope and roughness stand for
     // it (the riser voxels keep their vertical fit and stay S_untrav).
-    if (cost > opt_.tau_c && s->count >= uint32_t(opt_.n_min) && !edge) {
-      const double n = s->count;
-      Eigen::Matrix3d own;
-      own << s->m2[0], s->m2[1], s->m2[2], s->m2[1], s->m2[3], s->m2[4], s->m2[2], s->m2[4],
-          s->m2[5];
-      own /= n;
-      es.computeDirect(own);
-      const Eigen::Vector3d oev = es.eigenvalues().cwiseMax(0.0);
+    if (cost > opt_.tau_c && s->count >= uint32_t(opt_.n_min)) {
+      const PointPlane own = point_plane(*s);
+      const Eigen::Vector3d& oev = own.eigenvalues;
       if (oev[2] > 0 && oev[1] >= 1e-2 * oev[2]) {  // not collinear
-        const double oslope = std::acos(std::min(1.0, std::abs(es.eigenvectors().col(0).z())));
+        const double oslope = std::acos(std::min(1.0, std::abs(own.normal.z())));
         const double orough = 1.0 - (oev[1] - oev[0]) / std::max(1e-18, oev[1] + oev[0]);
         if (oslope <= 0.5 * robot_.max_slope_rad)
           cost = std::min(cost, opt_.w_s * oslope / robot_.max_slope_rad + opt_.w_r * orough +

@@ -67,7 +67,8 @@ struct VoxelStats {
   float normal_z = 1;                // |n_v . e_z| of the aggregated normal
   uint32_t reach_dist = 0;           // hop count from the C_reach root (decremental BFS invariant)
   uint8_t reasons = 0;  // why tau(v) is not S_trav: kReason* bits (diagnostics, export)
-  uint8_t shape = 0;    // kStepEdge: set with tau(v) from v's own points and the voxel above
+  uint8_t shape = 0;    // kStepEdge: set before tau(v) from v's points, the voxel above and
+                        // the neighbours' means (TraversabilityMap::step_edge)
 
   static constexpr uint8_t kReasonNotTop = 1;      // voxel above is occupied (not a surface)
   static constexpr uint8_t kReasonDegenerate = 2;  // neighbourhood points are collinear
@@ -101,11 +102,14 @@ struct VoxelStats {
 // Height of v's surface relative to its centre: the points' mean, or for a step edge the top
 // of its riser (mean + sqrt(3) sd: the upper end of points spread evenly over the riser's
 // height), within the voxel.
+inline float sheet_top_offset(const VoxelStats& s) {
+  const float sd = std::sqrt(std::max(0.0f, s.m2[5] / float(std::max(1u, s.count))));
+  return s.mean[2] + 1.7320508f * sd;
+}
 inline float surface_offset(const VoxelStats* s, float voxel_size) {
   if (!s || !s->count) return 0.0f;
   if (!(s->shape & VoxelStats::kStepEdge)) return s->mean[2];
-  const float sd = std::sqrt(std::max(0.0f, s->m2[5] / float(s->count)));
-  return std::min(s->mean[2] + 1.7320508f * sd, 0.5f * voxel_size);
+  return std::min(sheet_top_offset(*s), 0.5f * voxel_size);
 }
 
 // A step edge's height is an estimate from moments: with a strip of tread on top of its riser

@@ -522,16 +522,17 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   // Every attempt failed. If the robot cannot turn where it stands (a dead end narrower than
   // the body's turning circle: every path back starts with a turn), the clusters are not to
   // blame: step straight to the nearest pose where it can turn, and plan again from there.
-  if (!failed.empty() && escape(in, out)) {
+  auto take_escape = [&](const char* reason) {
     has_target_ = true;
     target_cluster_ = -1;
     target_m_ = out.target_m;
     current_ = out.trajectory;
     planned_at_s_ = in.t_s;
-    out.replan_reason = "escape: cannot turn here";
+    out.replan_reason = reason;
     out.status = LocalPlanStatus::kNewTrajectory;
     return out;
-  }
+  };
+  if (!failed.empty() && escape(in, out)) return take_escape("escape: cannot turn here");
   // Every attempt's body hit an obstacle next to the start: the start is boxed in (it faces a
   // wall, or stands by a wall end it cannot curve away from), not the clusters: step away from
   // the nearest of those obstacles and plan again from there.
@@ -547,14 +548,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   }
   if (boxed_in && start_escapes_ < opt_.max_start_escapes && escape(in, out, &hit)) {
     ++start_escapes_;
-    has_target_ = true;
-    target_cluster_ = -1;
-    target_m_ = out.target_m;
-    current_ = out.trajectory;
-    planned_at_s_ = in.t_s;
-    out.replan_reason = "escape: boxed in by an obstacle next to the start";
-    out.status = LocalPlanStatus::kNewTrajectory;
-    return out;
+    return take_escape("escape: boxed in by an obstacle next to the start");
   }
   // Stage 3 failed for these clusters: after max_failures cycles a cluster is set aside.
   for (const auto& [m, why, hit_m] : failed) {
