@@ -165,6 +165,7 @@ void read_plan(SectionReader&& r, core::plan::PlanOptions& o) {
   r.get("zone_merge_distance_m", o.zone_merge_distance_m, Range{0.0, 100.0});
   r.get("zone_visit_radius_m", o.zone_visit_radius_m, Range{0.1, 50.0});
   r.get("use_prior", o.use_prior);
+  r.get("climb_blind", o.climb_blind);
   r.get("incremental_maintenance", o.incremental_maintenance);
 }
 
@@ -255,6 +256,8 @@ void read_root(SectionReader& r, Parameters& p) {
   read_map(r.section("map"), p.map);
   read_graph(r.section("graph"), p.graph);
   read_plan(r.section("plan"), p.plan);
+  // One switch for the experimental blind stair climb, read by the map and the graph as well.
+  p.map.pool_short_risers = p.graph.climb_frontiers = p.plan.climb_blind;
   read_sensor(r.section("sensor"), p.sensor);
   read_rates(r.section("rates"), p.rates);
   read_safety(r.section("safety"), p.safety);

@@ -149,6 +149,30 @@ void Autonomy::ingest_step() {
   }
 }
 
+namespace {
+// Ground observed more than a step under a foot-height point, within a metre: the point lies over
+// a drop or the treads of a flight going down, not on the floor the robot stands on.
+bool below_foot(const core::map::MapView& view, const Eigen::Vector3f& p) {
+  const float vs = float(view.voxel_size_m());
+  for (float dz = float(view.robot().step_height_m) + vs; dz <= 1.0f; dz += vs)
+    if (view.is_occupied(view.key_of(p - Eigen::Vector3f(0, 0, dz)))) return true;
+  return false;
+}
+
+// Share of the columns within 0.5 m of the foot that hold support at its height.
+float support_fraction(const core::map::MapView& view, const Eigen::Vector3f& foot) {
+  const float vs = float(view.voxel_size_m());
+  int n = 0, with = 0;
+  for (float x = -0.5f; x <= 0.5f + 1e-4f; x += vs)
+    for (float y = -0.5f; y <= 0.5f + 1e-4f; y += vs) {
+      if (x * x + y * y > 0.25f + 1e-4f) continue;
+      ++n;
+      with += view.support_surface_near(foot + Eigen::Vector3f(x, y, 0), 0.15).has_value();
+    }
+  return n ? float(with) / float(n) : 1.0f;
+}
+}  // namespace
+
 // ---- map + graph (10 Hz): insert scans, traversability, C_reach, G_real, frontiers, clusters,
 // viewpoints; publish the world model.
 void Autonomy::map_step() {
@@ -163,7 +187,16 @@ void Autonomy::map_step() {
   PoseSample pose;
   if (pose_mb_.read(pose) == 0) return;  // no odometry yet: C_reach needs the robot's foot
   const Eigen::Vector3f foot = pose.position().cast<float>();
-  if (!startup_support_done_ && scans_inserted_ > 0) insert_startup_support(foot);
+  if (!startup_support_done_ && scans_inserted_ > 0) {
+    startup_support_done_ = true;
+    startup_points_ = insert_startup_support(foot);
+  } else if (opt_.params.plan.climb_blind && scans_inserted_ > 0 &&
+             (foot - last_support_foot_).norm() > 1.0f &&
+             support_fraction(map_.view(), foot) < 0.5f) {
+    // Stepped onto ground the LiDAR has not seen (a landing reached blind from a flight, whose
+    // pitch kept the LiDAR looking over it): the legs stand on it, enter it as well.
+    insert_startup_support(foot);
+  }
   map_.update_traversability();
   map_.update_reachable(foot);
   const core::map::MapView view = map_.view();
@@ -208,10 +241,10 @@ void Autonomy::map_step() {
 // observed support: points at foot height on a 3.3 cm grid within the blind radius, each kept
 // only if the line of sight from the sensor to it is free in the first scans (walls and drops
 // already seen clip it). Without it a VLP-16 in a 2 m corridor sees no floor to start from.
-void Autonomy::insert_startup_support(const Eigen::Vector3f& foot) {
-  startup_support_done_ = true;
+size_t Autonomy::insert_startup_support(const Eigen::Vector3f& foot) {
+  last_support_foot_ = foot;
   const double down = -opt_.fov.v_min_deg * M_PI / 180.0;
-  if (down <= 0.01 || opt_.startup_support_radius_m <= 0) return;
+  if (down <= 0.01 || opt_.startup_support_radius_m <= 0) return 0;
   const float r = float(
       std::min(opt_.startup_support_radius_m, opt_.fov.mount_height_m / std::tan(down) + 0.3));
   const Eigen::Vector3f origin = foot + Eigen::Vector3f(0, 0, float(opt_.fov.mount_height_m));
@@ -223,11 +256,12 @@ void Autonomy::insert_startup_support(const Eigen::Vector3f& foot) {
       if (x * x + y * y > r * r) continue;
       const Eigen::Vector3f p = foot + Eigen::Vector3f(x, y, -0.01f);
       if (view.first_occupied(origin, p + Eigen::Vector3f(0, 0, 0.12f))) continue;
+      if (below_foot(view, p)) continue;
       pts.push_back(p);
     }
   map_.insert_scan(origin, pts);
   changed_.push_back(core::graph::scan_bounds(origin, pts));
-  startup_points_ = pts.size();
+  return pts.size();
 }
 
 // ---- plan (2 Hz): the exploration policy (the paper's ExplorationPlanner or a baseline) on the

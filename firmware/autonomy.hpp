@@ -170,7 +170,7 @@ class Autonomy {
   double now_s() const { return double(clock_.now_ns()) * 1e-9; }
   void ingest_step();
   void map_step();
-  void insert_startup_support(const Eigen::Vector3f& foot);
+  size_t insert_startup_support(const Eigen::Vector3f& foot);  // points entered
   void plan_step();
   void count_exhausted(const WorldModel& w, ExplorationStatus& s);
   void control_step();
@@ -203,6 +203,7 @@ class Autonomy {
   std::vector<std::pair<uint64_t, core::graph::Aabb>> pending_changes_;  // not yet seen by plan
   uint64_t map_cycle_ = 0, scans_inserted_ = 0;
   bool startup_support_done_ = false;
+  Eigen::Vector3f last_support_foot_ = Eigen::Vector3f::Constant(1e9f);  // last insertion
   size_t startup_points_ = 0;
   rt::Snapshot<WorldModel> world_;
 

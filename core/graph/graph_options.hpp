@@ -16,10 +16,13 @@ struct GraphOptions {
   double surface_radius_factor = 1.0;         // radius of Omega_i = factor * r_e
   int probes = 12;                            // radial probes for C_exp
   int theta_min = 2;                          // Theta_min, open directions for C_exp
-  double probe_length_m = 3.0;                // probe length for C_exp
-  int cluster_capacity = 8;                   // maximum frontier nodes per cluster
-  int viewpoints_per_cluster = 8;             // K, best viewpoints kept per cluster
-  double viewpoint_radius_m = 2.5;            // candidate viewpoints from nodes within this radius
+  // Experimental (issue #9, set by plan.climb_blind): one open probe that climbed a stair step
+  // satisfies C_exp (a flight is one probe wide), and a probe follows a flight to its top.
+  bool climb_frontiers = false;
+  double probe_length_m = 3.0;      // probe length for C_exp
+  int cluster_capacity = 8;         // maximum frontier nodes per cluster
+  int viewpoints_per_cluster = 8;   // K, best viewpoints kept per cluster
+  double viewpoint_radius_m = 2.5;  // candidate viewpoints from nodes within this radius
   // Ablation switches (paper Table III).
   bool use_tentative = true;        // false: "w/o tentative", graph restricted to C_reach
   bool use_c_sur = true;            // false: "w/o surface criterion"

@@ -215,10 +215,15 @@ bool SupportQuery::probe_open(const Eigen::Vector3f& from, const Eigen::Vector3f
   return !seg.hit && !seg.closed && unknown_run >= need_unknown;
 }
 
+namespace {
+constexpr float kStairGrade = 0.466f;  // tan(25 deg)
+}  // namespace
+
 bool SupportQuery::probe_open_climbing(const Eigen::Vector3f& foot, const Eigen::Vector2f& dir,
                                        float length_m, float height_m, float min_free_m,
-                                       float min_unknown_m) {
+                                       float min_unknown_m, bool* climbed) {
   constexpr int kMaxClimbs = 24;
+  if (climbed) *climbed = false;
   // Horizontal probe: |dx| + |dy| voxels per metre (6-connected walk).
   const float per_m = (std::abs(dir.x()) + std::abs(dir.y())) * inv_vs_;
   const int need_free = int(std::ceil(min_free_m * per_m));
@@ -226,10 +231,14 @@ bool SupportQuery::probe_open_climbing(const Eigen::Vector3f& foot, const Eigen:
   const float max_rise = 2.0f * step_;
   float s0 = 0, s_climb = 0, zc = foot.z();
   int free_total = 0, unknown_run = 0;
-  for (int climb = 0; climb <= kMaxClimbs && s0 < length_m; ++climb) {
+  // The probe reaches length_m past its last climb: it follows a flight to its top (a node low
+  // on a 5 m flight sees only known treads within 3 m).
+  // (GraphOptions::climb_frontiers; else length_m from the node).
+  const bool follow = opt_.climb_frontiers;
+  for (int climb = 0; climb <= kMaxClimbs && s0 < (follow ? s_climb : 0.0f) + length_m; ++climb) {
+    const float s_end = (follow ? s_climb : 0.0f) + length_m;
     const Eigen::Vector3f from(foot.x() + dir.x() * s0, foot.y() + dir.y() * s0, zc + height_m);
-    const Eigen::Vector3f to(foot.x() + dir.x() * length_m, foot.y() + dir.y() * length_m,
-                             zc + height_m);
+    const Eigen::Vector3f to(foot.x() + dir.x() * s_end, foot.y() + dir.y() * s_end, zc + height_m);
     const ProbeSegment seg = probe_segment(from, to, need_free, &free_total, &unknown_run);
     if (seg.closed) return false;
     if (!seg.hit) return unknown_run >= need_unknown;
@@ -242,6 +251,9 @@ bool SupportQuery::probe_open_climbing(const Eigen::Vector3f& foot, const Eigen:
         rise <= step_ + tan_slope_ * std::max(0.0f, s_hit - s_climb)) {
       // A step up onto support the LiDAR saw only edge-on (a tread seen from below: its
       // riser's top, N(v) < N_min): terrain not yet observed, what the probe looks for.
+      // A stair's step: steeper than tan(25 deg) since the last climb (flights ~30 deg; a ramp,
+      // 5-20 deg in buildings, keeps the ground ahead in the LiDAR's view: judged as level).
+      if (climbed && rise >= kStairGrade * std::max(s_hit - s_climb, vs_)) *climbed = true;
       if (top->state == TravState::kUnobserved) return free_total >= need_free;
       zc = top->p_m.z();
       s_climb = s_hit;

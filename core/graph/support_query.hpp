@@ -98,9 +98,11 @@ class SupportQuery {
   // edge-on from below) or meeting an obstacle with unknown space right above it counts as
   // reaching unobserved terrain (open). Otherwise as probe_open. Without this, a stair's risers
   // close every probe at body height up the flight and the stairs never become a frontier (paper
-  // III-C: stairs are the way to the next floor).
+  // III-C: stairs are the way to the next floor). `climbed` (optional) tells whether an open
+  // probe had climbed at least one stair step (steeper than 25 deg) first: it runs up a flight.
   bool probe_open_climbing(const Eigen::Vector3f& foot, const Eigen::Vector2f& dir, float length_m,
-                           float height_m, float min_free_m, float min_unknown_m);
+                           float height_m, float min_free_m, float min_unknown_m,
+                           bool* climbed = nullptr);
 
   const map::MapView& view() const { return view_; }
   float voxel_size() const { return vs_; }

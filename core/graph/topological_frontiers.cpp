@@ -47,13 +47,16 @@ float TopologicalFrontiers::missing_surface_ratio(SupportQuery& q, const GraphNo
 
 // C_exp: probes at body height along directions not covered by an edge (within alpha_min / 2);
 // open if the probe crosses known free space and then reaches an unknown region (at least
-// probe_unknown_m of it) without hitting an obstacle first.
-int TopologicalFrontiers::open_directions(SupportQuery& q, const ReachableGraph& g, NodeId i) {
+// probe_unknown_m of it) without hitting an obstacle first. *up counts the open probes that
+// climbed first.
+int TopologicalFrontiers::open_directions(SupportQuery& q, const ReachableGraph& g, NodeId i,
+                                          int* up) {
   const GraphNode& n = g.node(i);
   const int probes = std::max(1, opt_.probes);
   const float half = float(opt_.alpha_min_rad) * 0.5f;
   const float min_free = 2.0f * q.voxel_size();
   int open = 0;
+  *up = 0;
   for (int k = 0; k < probes; ++k) {
     const float th = 2.0f * float(M_PI) * float(k) / float(probes);
     bool covered = false;
@@ -64,9 +67,12 @@ int TopologicalFrontiers::open_directions(SupportQuery& q, const ReachableGraph&
       covered = std::abs(diff) < half;
     }
     if (covered) continue;
-    open += q.probe_open_climbing(n.p_m, Eigen::Vector2f(std::cos(th), std::sin(th)),
-                                  float(opt_.probe_length_m), float(opt_.probe_height_m), min_free,
-                                  float(opt_.probe_unknown_m));
+    bool climbed = false;
+    const bool o = q.probe_open_climbing(n.p_m, Eigen::Vector2f(std::cos(th), std::sin(th)),
+                                         float(opt_.probe_length_m), float(opt_.probe_height_m),
+                                         min_free, float(opt_.probe_unknown_m), &climbed);
+    open += o;
+    *up += o && climbed;
   }
   return open;
 }
@@ -126,9 +132,12 @@ void TopologicalFrontiers::evaluate_flags(ReachableGraph& g, SupportQuery& q, No
     n.c_sur = omega * 4 >= std::max(1, opt_.surface_samples) && n.rho >= float(opt_.rho_min);
   }
   if (opt_.use_c_exp) {
-    const int open = open_directions(q, g, i);
+    int up = 0;
+    const int open = open_directions(q, g, i, &up);
     n.open_dirs = uint8_t(std::min(open, 255));
-    n.c_exp = open >= opt_.theta_min;
+    // A flight of stairs is one probe wide: its walls close the probes beside it.
+    // One probe that climbs it into unknown space is the way to the next floor (Sec. III-C).
+    n.c_exp = open >= opt_.theta_min || (opt_.climb_frontiers && up >= 1);
   }
 }
 

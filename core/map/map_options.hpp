@@ -4,6 +4,9 @@
 namespace storey::core::map {
 
 struct MapOptions {
+  // Experimental (issue #9, set by plan.climb_blind): a riser's short top piece is judged with
+  // the riser below it (riser_plane), and a sheet over observed open air is a ledge, not a step.
+  bool pool_short_risers = false;
   // --- occupancy (ray casting) ---
   double voxel_size_m = 0.1;    // map resolution
   double max_range_m = 30.0;    // rays beyond this are truncated (free space only, no endpoint)

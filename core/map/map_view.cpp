@@ -73,7 +73,11 @@ std::optional<Eigen::Vector2f> MapView::riser_normal(const VoxelKey& k) const {
   if (occupancy_of(r.cell(k), occ_threshold(*opt_)) != Occupancy::kOccupied) return std::nullopt;
   const VoxelStats* s = r.stats(k);
   if (!s || !(s->shape & VoxelStats::kStepEdge)) return std::nullopt;
-  const Eigen::Vector2d n = point_plane(*s).normal.head<2>();
+  const VoxelKey kb{k.x, k.y, k.z - 1};
+  const bool below = opt_->pool_short_risers &&
+                     occupancy_of(r.cell(kb), occ_threshold(*opt_)) == Occupancy::kOccupied;
+  const Eigen::Vector2d n =
+      riser_plane(*s, below ? r.stats(kb) : nullptr, opt_->voxel_size_m).normal.head<2>();
   if (n.norm() < 1e-6) return std::nullopt;
   return n.normalized().cast<float>();
 }

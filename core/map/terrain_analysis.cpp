@@ -78,24 +78,16 @@ TravUpdateStats TraversabilityMap::update_traversability() {
   return st;
 }
 
-namespace {
-// Points on a tilted sheet (thin across, spread along; 2 cm range noise makes risers ~1.5 cm
-// thick) more than 15 deg off level: a riser, or a riser with a strip of its tread on top (a
-// nosing in mid-voxel).
-bool steep_sheet(const PointPlane& p) {
-  const Eigen::Vector3d& ev = p.eigenvalues;
-  return ev[1] > 0 && ev[0] < 0.6 * ev[1] && std::abs(p.normal.z()) < std::cos(M_PI / 12);
-}
-}  // namespace
-
 bool TraversabilityMap::step_edge(const VoxelKey& k, const VoxelStats& s) {
   if (s.count < uint32_t(opt_.n_min)) return false;
+  auto stats_of = [this](const VoxelKey& w) { return occupied(rcell(w)) ? rstats(w) : nullptr; };
   const Cell* up = rcell({k.x, k.y, k.z + 1});
   if (!up || !(up->flags & Cell::kObserved) || occupied(up)) return false;  // rays crossed above
   const double vs = opt_.voxel_size_m;
   const double top = sheet_top_offset(s);  // upper end of the points
   if (top < 0.0) return false;             // they end in v's lower half
-  const PointPlane own = point_plane(s);
+  const PointPlane own =
+      opt_.pool_short_risers ? riser_plane(s, stats_of({k.x, k.y, k.z - 1}), vs) : point_plane(s);
   if (!steep_sheet(own)) return false;
   // A step, not a slope: along the sheet's normal one neighbouring column holds no surface
   // within a step of v's top that is a little higher (a slope rises on), and one holds none
@@ -119,7 +111,15 @@ bool TraversabilityMap::step_edge(const VoxelKey& k, const VoxelStats& s) {
       if (hw > h - 0.08 && hw <= h + 0.5 * vs)
         level |= !sw || sw->count < uint32_t(opt_.n_min) || !steep_sheet(point_plane(*sw));
     }
-    if (!level) ++drop_sides, drop_sign = side;
+    if (level) continue;
+    // A ledge, not a step: rays crossed the drop column more than a step below v's top (under
+    // a nosing that space is the stair's solid, never seen; under a slab edge over a stairwell
+    // it is open air).
+    const Cell* below =
+        rcell({cx, cy, int32_t(std::floor((h - robot_.step_height_m - 0.03) / vs))});
+    if (opt_.pool_short_risers && below && (below->flags & Cell::kObserved) && !occupied(below))
+      return false;
+    ++drop_sides, drop_sign = side;
   }
   if (drop_sides == 0) return false;
   // A riser on a column boundary smears into the columns on both sides. The column in front of

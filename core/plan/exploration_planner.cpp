@@ -191,7 +191,10 @@ ExplorationResult ExplorationPlanner::plan_cycle(const ExplorationInput& in) {
   li.robot_yaw_rad = in.robot_yaw_rad;
   li.t_s = in.t_s;
   bool zones_left = false;
-  const bool on_target = hybrid_.has_prior() && hybrid_.target_floor() == r.floor;
+  // An escape or a climb under way is driven to its end before guidance picks a zone (a climb
+  // onto a landing ends on the new floor, where the prior is built on arrival).
+  const bool on_target =
+      hybrid_.has_prior() && hybrid_.target_floor() == r.floor && !local_.committed();
   if (!on_target) hybrid_updated_last_ = false;
   if (on_target) {
     // Changed regions only count if the previous cycle's maintenance saw the ones before.

@@ -200,29 +200,124 @@ bool LocalPlanner::escape(const LocalPlanInput& in, LocalPlanResult& out,
       if (away_from && dist_xy(b) < dist_xy(start_foot_m_) + 0.5 * d) continue;
       b.z() = s->height_m;
       if (!can_turn(*in.view, b, start_yaw_)) continue;
-      std::vector<Eigen::Vector3d> c(3, start_foot_m_);
+      std::vector<Eigen::Vector3d> pts;
       const int n = std::max(1, int(std::ceil(d / spacing)));
-      for (int j = 1; j < n; ++j)
-        c.push_back(start_foot_m_ + (b - start_foot_m_) * (double(j) / n));
-      c.insert(c.end(), 3, b);
-      // Knot interval: half speed, and the acceleration limit at the tripled ends.
-      const double dt = std::max(d / n / (0.5 * robot_.max_speed_mps),
-                                 std::sqrt(d / n / std::max(robot_.max_accel_mps2, 1e-3)));
-      const std::vector<double> yaw(c.size(), start_yaw_);
-      BsplineTrajectory t(std::move(c), yaw, dt, in.t_s);
-      if (checker_
-              .check_ahead(
-                  *in.view, [&](double tt) { return t.pose(tt); }, t.t_start(), t.duration(), 0.0)
-              .collides)
-        continue;
-      out.trajectory = std::move(t);
-      out.path_m = {start_foot_m_, b};
-      out.target_m = b;
-      out.target_yaw_rad = start_yaw_;
-      out.real_until_s = out.trajectory.t_end();
-      return true;
+      for (int j = 0; j <= n; ++j)
+        pts.push_back(start_foot_m_ + (b - start_foot_m_) * (double(j) / n));
+      if (straight_walk(in, pts, start_yaw_, out)) return true;
     }
   return false;
+}
+
+bool LocalPlanner::straight_walk(const LocalPlanInput& in, const std::vector<Eigen::Vector3d>& pts,
+                                 double yaw, LocalPlanResult& out) {
+  if (pts.size() < 2) return false;
+  std::vector<Eigen::Vector3d> c(2, pts.front());
+  c.insert(c.end(), pts.begin(), pts.end());
+  c.insert(c.end(), 2, pts.back());
+  double len = 0;
+  for (size_t j = 1; j < pts.size(); ++j) len += (pts[j] - pts[j - 1]).head<2>().norm();
+  const double seg = len / double(pts.size() - 1);
+  // Knot interval: half speed, and the acceleration limit at the tripled ends.
+  const double dt = std::max(seg / (0.5 * robot_.max_speed_mps),
+                             std::sqrt(seg / std::max(robot_.max_accel_mps2, 1e-3)));
+  const std::vector<double> yaws(c.size(), yaw);
+  BsplineTrajectory t(std::move(c), yaws, std::max(dt, 1e-3), in.t_s);
+  const CollisionHit hit = checker_.check_ahead(
+      *in.view, [&](double tt) { return t.pose(tt); }, t.t_start(), t.duration(), 0.0);
+  if (hit.collides) return false;
+  out.trajectory = std::move(t);
+  out.path_m = {pts.front(), pts.back()};
+  out.target_m = pts.back();
+  out.target_yaw_rad = yaw;
+  out.real_until_s = out.trajectory.t_end();
+  return true;
+}
+
+// On a flight the body pitches with the stairs and the LiDAR's +-15 deg look over the treads
+// ahead: the rest of the flight and its landing are never seen from on it, and a frontier there
+// stays one however long the robot stands on it. Facing up a flight (its axis from the map's
+// risers, flight_axis), walk straight up the axis to the last support seen and landing_step_m
+// beyond it: the legs find the landing (the firmware enters the ground under the feet as support
+// when the map has none there) and the LiDAR, level again, sees the floor. The blind part is
+// allowed only where rays crossed the body's space (no wall unseen) and nothing observed lies
+// more than a step below the last support (no known drop).
+bool LocalPlanner::climb_on(const LocalPlanInput& in, LocalPlanResult& out, bool on_flight_only) {
+  const map::MapView& view = *in.view;
+  const Eigen::Vector3d foot = in.robot_foot_m;
+  // The flight the robot faces; at a frontier at a flight's foot (not yet on it) also one beside
+  // or behind it (the walk turns onto the axis).
+  std::optional<FlightAxis> axis;
+  for (int k = 0; k < (on_flight_only ? 1 : 4) && !axis; ++k) {
+    const double yaw = in.robot_yaw_rad + k * M_PI / 2;
+    const Eigen::Vector2d face(std::cos(yaw), std::sin(yaw));
+    axis = flight_axis(view, foot, face, 1.0);
+    if (axis && axis->dir.dot(face) < std::cos(M_PI / 4)) axis.reset();
+  }
+  if (!axis) return false;
+  const double vs = view.voxel_size_m(), step = robot_.step_height_m;
+  const Eigen::Vector2d o =
+      axis->origin + axis->dir * (foot.head<2>() - axis->origin).dot(axis->dir);
+  if (on_flight_only) {  // a tread lower behind the robot: it stands on the flight
+    const Eigen::Vector2d b = o - 0.5 * axis->dir;
+    const auto sb = view.support_surface_near(
+        Eigen::Vector3f(float(b.x()), float(b.y()), float(foot.z() - step)), 0.5 * step + 0.05);
+    if (!sb || sb->height_m > foot.z() - 0.5 * step) return false;
+  }
+  // Up the axis over the support the map holds; unseen treads (edge-on) are bridged up to 0.45 m.
+  std::vector<Eigen::Vector3d> pts{foot};
+  double z = foot.z(), s_last = 0, gap = 0;
+  for (double s = vs; s <= 8.0 && gap <= 0.45; s += vs) {
+    const Eigen::Vector2d q = o + s * axis->dir;
+    const auto sp = view.support_surface_near(
+        Eigen::Vector3f(float(q.x()), float(q.y()), float(z + 0.5 * step)), 0.5 * step + 0.03);
+    if (sp && sp->height_m >= z - 0.03) {
+      z = sp->height_m, s_last = s, gap = 0;
+      pts.emplace_back(q.x(), q.y(), z);
+    } else {
+      gap += vs;
+    }
+  }
+  if (z - foot.z() < 0.5 * step && s_last < 0.3) return false;  // nothing to climb ahead
+  // Stairs only: on a ramp the body pitches less than the LiDAR's half field of view and the
+  // ground ahead stays in sight. A flight shows its nosings as step edges.
+  int edges = 0;
+  for (const Eigen::Vector3d& p : pts)
+    edges += view.is_step_edge(
+        view.key_of(Eigen::Vector3f(float(p.x()), float(p.y()), float(p.z() - 0.01))));
+  if (edges < 3) return false;
+  // Onto the landing, blind: rays crossed the body's space there, no drop observed below.
+  const double body_lo = z + step, body_hi = z + robot_.body_height_m;
+  for (double s = s_last + vs; s <= s_last + opt_.landing_step_m + 1e-9; s += vs) {
+    const Eigen::Vector2d q = o + s * axis->dir;
+    bool seen = false;
+    for (double h = body_lo; h <= body_hi; h += vs) {
+      const map::Occupancy oc =
+          view.occupancy(Eigen::Vector3f(float(q.x()), float(q.y()), float(h)));
+      if (oc == map::Occupancy::kOccupied) return false;
+      seen |= oc == map::Occupancy::kFree;
+    }
+    if (!seen) return false;
+    for (double h = z - step - vs; h >= z - 1.0; h -= vs)
+      if (view.occupancy(Eigen::Vector3f(float(q.x()), float(q.y()), float(h))) ==
+          map::Occupancy::kOccupied)
+        return false;
+    pts.emplace_back(q.x(), q.y(), z);
+  }
+  // The body moves over the nosings, not down into each tread: heights no lower than the line
+  // from the robot to the last support, nor than the next tread within 0.2 m ahead (a stepwise
+  // profile, smoothed by the B-spline, dips the body into the risers).
+  const double s_top = std::max(s_last, vs);
+  const std::vector<Eigen::Vector3d> sup = pts;
+  for (Eigen::Vector3d& p : pts) {
+    const double s = std::clamp((p.head<2>() - o).dot(axis->dir), 0.0, s_top);
+    p.z() = std::max(p.z(), foot.z() + (z - foot.z()) * s / s_top);
+    for (const Eigen::Vector3d& q : sup) {
+      const double ds = (q.head<2>() - p.head<2>()).dot(axis->dir);
+      if (ds > 0 && ds <= 0.2 + 1e-6) p.z() = std::max(p.z(), q.z());
+    }
+  }
+  return straight_walk(in, pts, std::atan2(axis->dir.y(), axis->dir.x()), out);
 }
 
 bool LocalPlanner::try_target(const LocalPlanInput& in, const Viewpoint& vp, LocalPlanResult& out,
@@ -292,6 +387,18 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   }
   const graph::ReachableGraph& g = *in.graph;
   out.clusters_total = int(in.clusters->size());
+  // An escape or a climb: a trajectory to a pose, not to a cluster, driven to its end.
+  auto commit = [&](const char* reason) {
+    has_target_ = true;
+    committed_ = plan_opt_.climb_blind;
+    target_cluster_ = -1;
+    target_m_ = out.target_m;
+    current_ = out.trajectory;
+    planned_at_s_ = in.t_s;
+    out.replan_reason = reason;
+    out.status = LocalPlanStatus::kNewTrajectory;
+    return out;
+  };
   out.set_aside_expired = expire_set_aside(in);
 
   // ---- Keep the current target unless there is a reason to replan.
@@ -302,7 +409,16 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     const double dxy = (in.robot_foot_m - target_m_).head<2>().norm();
     const bool reached =
         dxy <= opt_.reached_radius_m && std::abs(in.robot_foot_m.z() - target_m_.z()) < 0.5;
-    if (reached || in.t_s > current_.t_end() + 3.0) {
+    // An escape or a climb runs to its end (a climb stopped half a metre short of its landing
+    // leaves the body's rear over the flight).
+    if (committed_ && (in.t_s >= current_.t_end() || dxy <= 0.1)) {
+      reason = in.t_s > current_.t_end() + 3.0 ? "escape or climb overdue" : "escape or climb done";
+      has_target_ = committed_ = false;
+    } else if (plan_opt_.climb_blind && !committed_ && reached && tc && climbs_ < opt_.max_climbs &&
+               climb_on(in, out, false)) {
+      ++climbs_;
+      return commit("climb on: a frontier on a flight is not seen from on it");
+    } else if (!committed_ && (reached || in.t_s > current_.t_end() + 3.0)) {
       // Stood at the viewpoint (or should have long ago) and the cluster is still there. First
       // walk onto the frontier itself (the LiDAR's blind ring moves with the robot, so the
       // ground beyond a frontier is often only seen from on top of it); if it still persists,
@@ -319,13 +435,20 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
       }
       reason = reached ? "target reached" : "target overdue";
       has_target_ = false;
-    } else if (!tc) {
+    } else if (!tc && !committed_) {
       reason = "target cluster observed";
       has_target_ = false;
     } else {
-      bool all_ignored = true;
-      for (graph::NodeId n : tc->nodes) all_ignored = all_ignored && ignored(g.node(n).p_m);
-      const double t_from = std::clamp(in.t_s, current_.t_start(), current_.t_end());
+      bool all_ignored = tc != nullptr;  // a committed escape or climb has no cluster
+      if (tc)
+        for (graph::NodeId n : tc->nodes) all_ignored = all_ignored && ignored(g.node(n).p_m);
+      // On the plan-time check's sample grid: the same poses, so an unchanged map gives the same
+      // answer (a pose grazing a nosing at the ground tolerance flipped between grids and the
+      // same trajectory was planned, dropped and planned again forever).
+      const double dt = checker_.max_dt_s();
+      double t_from = std::clamp(in.t_s, current_.t_start(), current_.t_end());
+      if (plan_opt_.climb_blind)
+        t_from = current_.t_start() + std::floor((t_from - current_.t_start()) / dt) * dt;
       const CollisionHit hit = checker_.check_ahead(
           *in.view, [&](double t) { return current_.pose(t); }, t_from,
           std::max(0.0, current_.t_end() - t_from), 0.0);
@@ -335,7 +458,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
       } else if (hit.collides) {
         reason = "trajectory collides on the new map";
         has_target_ = false;
-      } else if (in.t_s - planned_at_s_ >= opt_.replan_period_s) {
+      } else if (!committed_ && in.t_s - planned_at_s_ >= opt_.replan_period_s) {
         reason = "periodic replan";
         has_target_ = false;
       } else {
@@ -352,6 +475,10 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   // ---- Stage 1: TSP over the cluster representatives (graph path costs).
   probe_mark(probe_, PlanStage::kLocalStage1);
   if (in.clusters->empty()) {
+    if (plan_opt_.climb_blind && climbs_ < opt_.max_climbs && climb_on(in, out, true)) {
+      ++climbs_;
+      return commit("climb on: no frontier, standing on a flight");
+    }
     out.status = LocalPlanStatus::kNoFrontiers;
     return out;
   }
@@ -403,6 +530,10 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     cand_dist.push_back(d);
   }
   if (cands.empty()) {
+    if (plan_opt_.climb_blind && climbs_ < opt_.max_climbs && climb_on(in, out, true)) {
+      ++climbs_;
+      return commit("climb on: no reachable frontier, standing on a flight");
+    }
     out.status = LocalPlanStatus::kNoReachableTarget;
     return out;
   }
@@ -507,7 +638,8 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
          ++k, ++attempts)
       ok = try_target(in, vps[k], out, &why);
     if (ok) {
-      start_escapes_ = 0;
+      start_escapes_ = climbs_ = 0;
+      committed_ = false;
       has_target_ = true;
       target_cluster_ = c.cluster_id;
       target_m_ = out.target_m;
@@ -522,17 +654,12 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   // Every attempt failed. If the robot cannot turn where it stands (a dead end narrower than
   // the body's turning circle: every path back starts with a turn), the clusters are not to
   // blame: step straight to the nearest pose where it can turn, and plan again from there.
-  auto take_escape = [&](const char* reason) {
-    has_target_ = true;
-    target_cluster_ = -1;
-    target_m_ = out.target_m;
-    current_ = out.trajectory;
-    planned_at_s_ = in.t_s;
-    out.replan_reason = reason;
-    out.status = LocalPlanStatus::kNewTrajectory;
-    return out;
-  };
-  if (!failed.empty() && escape(in, out)) return take_escape("escape: cannot turn here");
+  if (plan_opt_.climb_blind && !failed.empty() && climbs_ < opt_.max_climbs &&
+      climb_on(in, out, true)) {
+    ++climbs_;
+    return commit("climb on: no way to a frontier, standing on a flight");
+  }
+  if (!failed.empty() && escape(in, out)) return commit("escape: cannot turn here");
   // Every attempt's body hit an obstacle next to the start: the start is boxed in (it faces a
   // wall, or stands by a wall end it cannot curve away from), not the clusters: step away from
   // the nearest of those obstacles and plan again from there.
@@ -548,7 +675,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   }
   if (boxed_in && start_escapes_ < opt_.max_start_escapes && escape(in, out, &hit)) {
     ++start_escapes_;
-    return take_escape("escape: boxed in by an obstacle next to the start");
+    return commit("escape: boxed in by an obstacle next to the start");
   }
   // Stage 3 failed for these clusters: after max_failures cycles a cluster is set aside.
   for (const auto& [m, why, hit_m] : failed) {

@@ -117,6 +117,8 @@ struct LocalPlannerOptions {
   double start_blame_radius_m = 0.7;     // every try hits an obstacle this close to the start:
                                          // the start is boxed in, not the clusters (escape)
   int max_start_escapes = 3;             // ... at most this many escapes in a row
+  double landing_step_m = 0.6;           // climb_on: past the last support seen on a flight
+  int max_climbs = 3;                    // climb_on moves in a row without a new target
   double set_aside_expiry_s = 30.0;      // a set-aside node may expire after this [s] ...
   double set_aside_expiry_move_m = 2.0;  // ... once the robot is this far from where it was
 };
@@ -127,8 +129,9 @@ class LocalPlanner {
                const LocalPlannerOptions& options = {});
   LocalPlanResult plan(const LocalPlanInput& in);
   // Forget the current target (after a safety stop the robot may be far from its trajectory).
-  void drop_target() { has_target_ = false; }
+  void drop_target() { has_target_ = committed_ = false; }
   bool has_target() const { return has_target_; }
+  bool committed() const { return has_target_ && committed_; }  // an escape or climb under way
   size_t set_aside_nodes() const { return set_aside_.size(); }
   uint64_t set_aside_expired() const { return expired_total_; }  // since construction
   // Diagnostics: the set-aside frontier nodes with their reasons; the entry of the set-aside
@@ -158,6 +161,13 @@ class LocalPlanner {
               const Eigen::Vector3f* away_from = nullptr);
   bool try_target(const LocalPlanInput& in, const Viewpoint& vp, LocalPlanResult& out,
                   SetAsideReason* why);
+  // Facing up a flight: straight up the flight's axis to the last support seen and
+  // landing_step_m beyond (see local_planner.cpp). on_flight_only: only if the robot stands on
+  // the flight already (a lower tread behind it).
+  bool climb_on(const LocalPlanInput& in, LocalPlanResult& out, bool on_flight_only);
+  // A straight walk at constant yaw through `pts` (foot points), checked against the map.
+  bool straight_walk(const LocalPlanInput& in, const std::vector<Eigen::Vector3d>& pts, double yaw,
+                     LocalPlanResult& out);
 
   RobotModel robot_;
   PlanOptions plan_opt_;
@@ -190,6 +200,8 @@ class LocalPlanner {
   std::vector<std::pair<int32_t, int>> failures_;
   Eigen::Vector3f last_hit_m_ = kNoHitM;  // try_target: where the last B-spline collided
   int start_escapes_ = 0;                 // escapes from a boxed-in start since the last target
+  int climbs_ = 0;                        // climb_on moves since the last target
+  bool committed_ = false;  // an escape or climb (PlanOptions::climb_blind): kept to its end
   std::vector<int32_t>
       approached_;  // clusters whose viewpoint was reached once (walk onto them next)
 };

@@ -269,8 +269,15 @@ FlightShaping shape_flights(const map::MapView& view, std::vector<Eigen::Vector3
     const Eigen::Vector2d ru2 = foot2 - run_up * axis->dir;
     const auto ru_sp = view.support_surface_near(
         Eigen::Vector3f(float(ru2.x()), float(ru2.y()), float(points[j].z())), level);
-    if (!ru_sp || !(ru_sp->reachable || ru_sp->state == map::TravState::kTraversable) ||
-        !clear_disc(view, ru2, ru_sp->height_m, half_w)) {
+    const bool run_up_ok = ru_sp &&
+                           (ru_sp->reachable || ru_sp->state == map::TravState::kTraversable) &&
+                           clear_disc(view, ru2, ru_sp->height_m, half_w);
+    // The robot stands on the flight (or at its foot): there is no room for a run-up behind it,
+    // and the flight is laid on its axis from here (else the raw path hugs a side wall).
+    // (Experimental, with the blind climb: MapOptions::pool_short_risers is its map side.)
+    const bool from_start =
+        view.options().pool_short_risers && (points[j] - points[0]).head<2>().norm() < run_up + s;
+    if (!run_up_ok && !from_start) {
       ++out.no_run_up;
       j = e;
       continue;
@@ -278,7 +285,7 @@ FlightShaping shape_flights(const map::MapView& view, std::vector<Eigen::Vector3
     // The flight's points along the axis, from the foot to the projection of its last point.
     const double s_end = (points[end].head<2>() - foot2).dot(axis->dir);
     std::vector<Eigen::Vector3d> line;
-    line.emplace_back(ru2.x(), ru2.y(), ru_sp->height_m);
+    if (run_up_ok) line.emplace_back(ru2.x(), ru2.y(), ru_sp->height_m);
     const int n = std::max(1, int(std::ceil(s_end / s)));
     double z_prev = points[j].z();
     for (int i = 0; i <= n; ++i) {
@@ -286,8 +293,11 @@ FlightShaping shape_flights(const map::MapView& view, std::vector<Eigen::Vector3
       const Eigen::Vector2d q = foot2 + t * axis->dir;
       const double expect =
           points[j].z() + (points[end].z() - points[j].z()) * (t / std::max(s_end, 1e-6));
-      const auto sp = view.support_surface_near(
-          Eigen::Vector3f(float(q.x()), float(q.y()), float(expect)), r.step_height_m);
+      // The foot stands on the lower level: the riser's smear in the column in front of it can
+      // read a tread higher.
+      const auto sp =
+          view.support_surface_near(Eigen::Vector3f(float(q.x()), float(q.y()), float(expect)),
+                                    i == 0 ? level : r.step_height_m);
       const double z = sp && std::abs(double(sp->height_m) - z_prev) <= r.step_height_m + 0.03
                            ? double(sp->height_m)
                            : expect;
@@ -296,7 +306,8 @@ FlightShaping shape_flights(const map::MapView& view, std::vector<Eigen::Vector3
     }
     // Replace the approach within a run-up of the foot, the flight, and its last point.
     size_t first = j;
-    while (first > 1 && (points[first - 1] - points[j]).head<2>().norm() < run_up) --first;
+    while (run_up_ok && first > 1 && (points[first - 1] - points[j]).head<2>().norm() < run_up)
+      --first;
     points.erase(points.begin() + long(first), points.begin() + long(end) + 1);
     points.insert(points.begin() + long(first), line.begin(), line.end());
     ++out.flights;

@@ -43,6 +43,11 @@ struct PlanOptions {
   double zone_visit_radius_m = 1.5;      // robot this close to c_k: zone visited (state C test)
   // Ablation switches (paper Table IV).
   bool use_prior = true;
+  // Experimental (issue #9): a frontier on a flight of stairs is not seen from on it (the body
+  // pitches with the flight, the LiDAR looks over the treads); climb on up the flight's axis onto
+  // the landing, blind past the last support seen, and drive escapes to their end. Off by
+  // default: the two-floor house is explored with it, test_ramp's ramp is not (docs/RESULTS.md).
+  bool climb_blind = false;
   bool incremental_maintenance = true;
 };
 

@@ -148,6 +148,20 @@ TEST(ConfigFiles, HilUsesUdpAndLoopback) {
 
 // ---- error kinds -----------------------------------------------------------------------------
 
+// The experimental blind stair climb is one switch; the map and the graph read it too.
+TEST(ConfigFiles, ClimbBlindSetsTheMapAndGraphSides) {
+  const Result off = load_string(kRequired, "t.yaml");
+  ASSERT_TRUE(off.ok());
+  EXPECT_FALSE(off.params.plan.climb_blind);
+  EXPECT_FALSE(off.params.map.pool_short_risers);
+  EXPECT_FALSE(off.params.graph.climb_frontiers);
+  const Result on = load_string("plan:\n  climb_blind: true\n" + kRequired, "t.yaml");
+  ASSERT_TRUE(on.ok());
+  EXPECT_TRUE(on.params.plan.climb_blind);
+  EXPECT_TRUE(on.params.map.pool_short_risers);
+  EXPECT_TRUE(on.params.graph.climb_frontiers);
+}
+
 TEST(ConfigErrors, UnknownKeyNamesFileKeyLineAndSuggestion) {
   const Result r = load_string(
       "# comment\n"
@@ -433,8 +447,9 @@ namespace {
 // change; update the figures here once both are done.
 TEST(ConfigSchema, CoreOptionStructsAreFullyMapped) {
   EXPECT_EQ(sizeof(core::RobotModel), 80u) << "RobotModel changed: update the config schema";
-  EXPECT_EQ(sizeof(core::map::MapOptions), 144u) << "MapOptions changed: update the config schema";
-  EXPECT_EQ(sizeof(core::graph::GraphOptions), 200u)
+  // MapOptions::pool_short_risers and GraphOptions::climb_frontiers are set by plan.climb_blind.
+  EXPECT_EQ(sizeof(core::map::MapOptions), 152u) << "MapOptions changed: update the config schema";
+  EXPECT_EQ(sizeof(core::graph::GraphOptions), 208u)
       << "GraphOptions changed: update the config schema";
   EXPECT_EQ(sizeof(core::plan::PlanOptions), 232u)
       << "PlanOptions changed: update the config schema";
