@@ -46,10 +46,12 @@ inline bool steep_sheet(const PointPlane& p) {
 // The plane of a riser's top piece. A rise of 0.167 m on a 0.1 m grid leaves 3.3 or 6.7 cm of
 // riser in the top voxel, no taller than the range noise makes it thick: its own scatter has
 // no clear normal. Then it is judged with the voxel below (its points pooled, `below` one
-// voxel lower), which holds the rest of the riser.
+// voxel lower), which holds the rest of the riser. A clear plane of its own (a riser, or a
+// level tread over one) stands as it is.
 inline PointPlane riser_plane(const VoxelStats& s, const VoxelStats* below, double voxel_size) {
   const PointPlane own = point_plane(s);
-  if (steep_sheet(own) || !below || below->count == 0 || s.count == 0) return own;
+  const bool clear = own.eigenvalues[1] > 0 && own.eigenvalues[0] < 0.6 * own.eigenvalues[1];
+  if (clear || !below || below->count == 0 || s.count == 0) return own;
   const double na = s.count, nb = below->count, n = na + nb;
   const Eigen::Vector3d ma(s.mean[0], s.mean[1], s.mean[2]);
   const Eigen::Vector3d mb(below->mean[0], below->mean[1], below->mean[2] - voxel_size);
