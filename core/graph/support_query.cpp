@@ -234,9 +234,9 @@ bool SupportQuery::probe_open_climbing(const Eigen::Vector3f& foot, const Eigen:
   // The probe reaches length_m past its last climb: it follows a flight to its top (a node low
   // on a 5 m flight sees only known treads within 3 m).
   // (GraphOptions::climb_frontiers; else length_m from the node).
-  const bool follow = opt_.climb_frontiers;
-  for (int climb = 0; climb <= kMaxClimbs && s0 < (follow ? s_climb : 0.0f) + length_m; ++climb) {
-    const float s_end = (follow ? s_climb : 0.0f) + length_m;
+  auto reach = [&] { return (opt_.climb_frontiers ? s_climb : 0.0f) + length_m; };
+  for (int climb = 0; climb <= kMaxClimbs && s0 < reach(); ++climb) {
+    const float s_end = reach();
     const Eigen::Vector3f from(foot.x() + dir.x() * s0, foot.y() + dir.y() * s0, zc + height_m);
     const Eigen::Vector3f to(foot.x() + dir.x() * s_end, foot.y() + dir.y() * s_end, zc + height_m);
     const ProbeSegment seg = probe_segment(from, to, need_free, &free_total, &unknown_run);

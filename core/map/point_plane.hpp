@@ -38,9 +38,11 @@ inline PointPlane point_plane(const VoxelStats& s) {
 // Points on a tilted sheet (thin across, spread along; 2 cm range noise makes risers ~1.5 cm
 // thick) more than 15 deg off level: a riser, or a riser with a strip of its tread on top (a
 // nosing in mid-voxel).
+inline bool clear_plane(const PointPlane& p) {  // thin across, spread along: a normal
+  return p.eigenvalues[1] > 0 && p.eigenvalues[0] < 0.6 * p.eigenvalues[1];
+}
 inline bool steep_sheet(const PointPlane& p) {
-  const Eigen::Vector3d& ev = p.eigenvalues;
-  return ev[1] > 0 && ev[0] < 0.6 * ev[1] && std::abs(p.normal.z()) < std::cos(M_PI / 12);
+  return clear_plane(p) && std::abs(p.normal.z()) < std::cos(M_PI / 12);
 }
 
 // The plane of a riser's top piece. A rise of 0.167 m on a 0.1 m grid leaves 3.3 or 6.7 cm of
@@ -50,8 +52,7 @@ inline bool steep_sheet(const PointPlane& p) {
 // level tread over one) stands as it is.
 inline PointPlane riser_plane(const VoxelStats& s, const VoxelStats* below, double voxel_size) {
   const PointPlane own = point_plane(s);
-  const bool clear = own.eigenvalues[1] > 0 && own.eigenvalues[0] < 0.6 * own.eigenvalues[1];
-  if (clear || !below || below->count == 0 || s.count == 0) return own;
+  if (clear_plane(own) || !below || below->count == 0 || s.count == 0) return own;
   const double na = s.count, nb = below->count, n = na + nb;
   const Eigen::Vector3d ma(s.mean[0], s.mean[1], s.mean[2]);
   const Eigen::Vector3d mb(below->mean[0], below->mean[1], below->mean[2] - voxel_size);

@@ -115,10 +115,11 @@ bool TraversabilityMap::step_edge(const VoxelKey& k, const VoxelStats& s) {
     // A ledge, not a step: rays crossed the drop column more than a step below v's top (under
     // a nosing that space is the stair's solid, never seen; under a slab edge over a stairwell
     // it is open air).
-    const Cell* below =
-        rcell({cx, cy, int32_t(std::floor((h - robot_.step_height_m - 0.03) / vs))});
-    if (opt_.pool_short_risers && below && (below->flags & Cell::kObserved) && !occupied(below))
-      return false;
+    if (opt_.pool_short_risers) {
+      const Cell* below =
+          rcell({cx, cy, int32_t(std::floor((h - robot_.step_height_m - 0.03) / vs))});
+      if (below && (below->flags & Cell::kObserved) && !occupied(below)) return false;
+    }
     ++drop_sides, drop_sign = side;
   }
   if (drop_sides == 0) return false;

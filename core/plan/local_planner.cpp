@@ -399,6 +399,13 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     out.status = LocalPlanStatus::kNewTrajectory;
     return out;
   };
+  // The blind climb (PlanOptions::climb_blind), at most max_climbs times without a new target.
+  auto try_climb = [&](bool on_flight_only) {
+    if (!plan_opt_.climb_blind || climbs_ >= opt_.max_climbs || !climb_on(in, out, on_flight_only))
+      return false;
+    ++climbs_;
+    return true;
+  };
   out.set_aside_expired = expire_set_aside(in);
 
   // ---- Keep the current target unless there is a reason to replan.
@@ -414,9 +421,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     if (committed_ && (in.t_s >= current_.t_end() || dxy <= 0.1)) {
       reason = in.t_s > current_.t_end() + 3.0 ? "escape or climb overdue" : "escape or climb done";
       has_target_ = committed_ = false;
-    } else if (plan_opt_.climb_blind && !committed_ && reached && tc && climbs_ < opt_.max_climbs &&
-               climb_on(in, out, false)) {
-      ++climbs_;
+    } else if (!committed_ && reached && tc && try_climb(false)) {
       return commit("climb on: a frontier on a flight is not seen from on it");
     } else if (!committed_ && (reached || in.t_s > current_.t_end() + 3.0)) {
       // Stood at the viewpoint (or should have long ago) and the cluster is still there. First
@@ -475,10 +480,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   // ---- Stage 1: TSP over the cluster representatives (graph path costs).
   probe_mark(probe_, PlanStage::kLocalStage1);
   if (in.clusters->empty()) {
-    if (plan_opt_.climb_blind && climbs_ < opt_.max_climbs && climb_on(in, out, true)) {
-      ++climbs_;
-      return commit("climb on: no frontier, standing on a flight");
-    }
+    if (try_climb(true)) return commit("climb on: no frontier, standing on a flight");
     out.status = LocalPlanStatus::kNoFrontiers;
     return out;
   }
@@ -530,10 +532,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     cand_dist.push_back(d);
   }
   if (cands.empty()) {
-    if (plan_opt_.climb_blind && climbs_ < opt_.max_climbs && climb_on(in, out, true)) {
-      ++climbs_;
-      return commit("climb on: no reachable frontier, standing on a flight");
-    }
+    if (try_climb(true)) return commit("climb on: no reachable frontier, standing on a flight");
     out.status = LocalPlanStatus::kNoReachableTarget;
     return out;
   }
@@ -654,11 +653,8 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   // Every attempt failed. If the robot cannot turn where it stands (a dead end narrower than
   // the body's turning circle: every path back starts with a turn), the clusters are not to
   // blame: step straight to the nearest pose where it can turn, and plan again from there.
-  if (plan_opt_.climb_blind && !failed.empty() && climbs_ < opt_.max_climbs &&
-      climb_on(in, out, true)) {
-    ++climbs_;
+  if (!failed.empty() && try_climb(true))
     return commit("climb on: no way to a frontier, standing on a flight");
-  }
   if (!failed.empty() && escape(in, out)) return commit("escape: cannot turn here");
   // Every attempt's body hit an obstacle next to the start: the start is boxed in (it faces a
   // wall, or stands by a wall end it cannot curve away from), not the clusters: step away from
