@@ -99,6 +99,30 @@ class CollisionChecker {
     }
     return check_poses(view, samples_);
   }
+  // The same, on the poses the plan-time check of a trajectory over [t_start, t_end] sampled
+  // (t_start + k * max_dt_s(), and t_end): from the last of them at or before t_from to the
+  // first at or after t_from + horizon_s. An unchanged map then gives the plan-time answer
+  // wherever along the trajectory the check starts (a pose grazing a stair nosing at the ground
+  // tolerance passed at plan time and failed half a sample later: the planner kept a trajectory
+  // the control look-ahead stopped the robot on, over and over).
+  template <class PoseAt>
+  CollisionHit check_on_grid(const map::MapView& view, PoseAt&& pose_at, double t_start,
+                             double t_end, double t_from, double horizon_s) {
+    const double dt = max_dt_s();
+    const double span = std::max(0.0, t_end - t_start);
+    const double a = std::clamp(t_from - t_start, 0.0, span);
+    const double b = std::clamp(a + std::max(0.0, horizon_s), 0.0, span);
+    const int k0 = int(std::floor(a / dt + 1e-9));
+    const int k1 = int(std::ceil(b / dt - 1e-9));
+    samples_.clear();
+    for (int k = k0; k <= k1; ++k) {
+      const double t = t_start + std::min(span, k * dt);
+      BodyPose p = pose_at(t);
+      p.t_s = t;
+      samples_.push_back(p);
+    }
+    return check_poses(view, samples_);
+  }
 
   // The straight segment a -> b (support points, z interpolated, pitch of the segment along
   // travel) at the given yaw, or the horizontal direction of travel if yaw_rad is NaN: for path

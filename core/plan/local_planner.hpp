@@ -6,7 +6,8 @@
 //            open tour from the robot, optionally ending at the macro layer's anchor c_anc;
 //   Stage 2  heading-aware DP (Eq. 6) choosing one viewpoint per cluster in the first W;
 //   Stage 3  voxel A* to the first viewpoint, then the collision-checked B-spline.
-// Between cycles it keeps its target (no dithering): it replans when the target cluster is gone,
+// Between cycles it keeps its target (no dithering): it replans when the target cluster is gone
+// (its frontier observed; a cluster that only changed its id is followed, track_radius_m),
 // the target is reached, the rest of the trajectory collides on the new map, or replan_period_s
 // passed. Frontier nodes that stay frontiers after the robot stood at their viewpoint, or whose
 // cluster repeatedly fails Stage 3, are set aside (they are not observable from where the robot
@@ -106,8 +107,13 @@ struct SetAsideEntry {
 uint16_t frontier_signature(const graph::GraphNode& n);
 
 struct LocalPlannerOptions {
-  int max_tsp_clusters = 12;             // nearest clusters (graph distance) entering Stage 1
-  double replan_period_s = 4.0;          // re-optimise a kept target this often
+  int max_tsp_clusters = 12;     // nearest clusters (graph distance) entering Stage 1
+  double replan_period_s = 4.0;  // re-optimise a kept target this often
+  // A cluster's id changes with its nodes (the frontier recedes as the robot comes near: new
+  // nodes, old ones no longer frontiers). A cluster with a frontier node this close to one of
+  // the target's is the same frontier: the target is kept, not "observed" and replanned (on
+  // test_ramp's landing ids churned every cycle and the robot turned between two targets).
+  double track_radius_m = 1.0;
   double reached_radius_m = 0.5;         // robot this close to the viewpoint = reached
   double set_aside_radius_m = 0.3;       // a frontier node this close to a set-aside one is ignored
   int max_failures = 2;                  // Stage 3 failures before a cluster is set aside
@@ -151,6 +157,9 @@ class LocalPlanner {
                          SetAsideReason reason, const Eigen::Vector3f& hit_m = kNoHitM);
   int expire_set_aside(const LocalPlanInput& in);
   const graph::FrontierCluster* find_cluster(const LocalPlanInput& in, int32_t id) const;
+  // The target cluster, under a new id if its nodes changed (see track_radius_m).
+  const graph::FrontierCluster* track_target(const LocalPlanInput& in);
+  void remember_target(const LocalPlanInput& in, const graph::FrontierCluster& c);
   void build_search_graph(const graph::ReachableGraph& g);
   // Stage 3 to one viewpoint; on failure *why says A* or trajectory.
   bool free_start(const LocalPlanInput& in);
@@ -190,6 +199,7 @@ class LocalPlanner {
   // Current target.
   bool has_target_ = false;
   int32_t target_cluster_ = -1;
+  std::vector<Eigen::Vector3f> target_nodes_m_;  // the target cluster's frontier nodes
   Eigen::Vector3d target_m_ = Eigen::Vector3d::Zero();
   BsplineTrajectory current_;
   double planned_at_s_ = 0;

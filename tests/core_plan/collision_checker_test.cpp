@@ -126,5 +126,40 @@ TEST(CollisionChecker, MapViewLookAheadAndSegments) {
   EXPECT_FALSE(cc.check_segment(view, {0, 1.2, 0}, {3.5, 1.2, 0}, std::nan("")).collides);
 }
 
+TEST(CollisionChecker, LookAheadOnTheGridChecksOnlyPlanTimePoses) {
+  // The plan-time check of a trajectory over [t0, t1] and a look-ahead started anywhere along
+  // it: the look-ahead's poses are plan-time poses, and they cover its window.
+  map::TraversabilityMap m;
+  const map::MapView view = m.view();
+  CollisionChecker cc(RobotModel{}, view.voxel_size_m());
+  const double t0 = 3.7, t1 = 9.15;
+  std::vector<double> plan_t, ahead_t;
+  auto record = [](std::vector<double>& into) {
+    return [&into](double t) {
+      into.push_back(t);
+      return BodyPose{{t, 0, 0}, 0.0};
+    };
+  };
+  cc.check_ahead(view, record(plan_t), t0, t1 - t0, 0.0);
+  ASSERT_GT(plan_t.size(), 10u);
+  for (double from : {t0, 4.0, 5.123, 8.9, t1}) {
+    ahead_t.clear();
+    cc.check_on_grid(view, record(ahead_t), t0, t1, from, 2.0);
+    ASSERT_FALSE(ahead_t.empty());
+    for (double t : ahead_t) {
+      bool on_grid = false;
+      for (double p : plan_t) on_grid = on_grid || std::abs(p - t) < 1e-9;
+      EXPECT_TRUE(on_grid) << "look-ahead from " << from << " sampled t = " << t;
+    }
+    EXPECT_LE(ahead_t.front(), from + 1e-9);
+    EXPECT_GE(ahead_t.back(), std::min(t1, from + 2.0) - 1e-9);
+    EXPECT_LE(ahead_t.back() - ahead_t.front(), 2.0 + 2 * cc.max_dt_s() + 1e-9);
+  }
+  // The plain look-ahead started half a sample off the grid samples other poses.
+  ahead_t.clear();
+  cc.check_ahead(view, record(ahead_t), t0 + 0.5 * cc.max_dt_s(), 1.0, 0.0);
+  EXPECT_GT(std::abs(ahead_t.front() - plan_t.front()), 1e-6);
+}
+
 }  // namespace
 }  // namespace storey::core::plan

@@ -138,3 +138,52 @@ TEST(LocalPlanner, SetAsideExpiresAfterTheTimeoutOnlyOnceTheRobotMoved) {
   EXPECT_EQ(r.set_aside_expired, int(s.p.size()));
   EXPECT_EQ(still_set_aside(lp, s), 0u);
 }
+
+TEST(LocalPlanner, TargetIsKeptWhenItsClusterOnlyChangedItsId) {
+  const World w = corridor();
+  Harness h;
+  const Eigen::Vector3f foot(0, 0, 0);
+  h.observe(w, foot, 40000, 1);
+  ASSERT_GE(h.clusters.clusters().size(), 2u);
+  LocalPlanner lp(RobotModel{}, PlanOptions{}, 0.1);
+  const auto view = h.map.view();
+  // Planned from off the scan origin, so the first viewpoint is not where the robot stands.
+  LocalPlanInput in = input(h, view, Eigen::Vector3f(0, 1.5f, 0), 0.0);
+  const LocalPlanResult r0 = lp.plan(in);
+  ASSERT_EQ(r0.status, LocalPlanStatus::kNewTrajectory);
+  const int32_t target = r0.target_cluster;
+  ASSERT_GE(target, 0);
+
+  // The same frontier under a new id (its nodes were re-clustered): the target is kept and
+  // followed under the new id.
+  std::vector<storey::core::graph::FrontierCluster> renamed = h.clusters.clusters();
+  for (auto& c : renamed)
+    if (c.id == target) c.id = 100000;
+  in.clusters = &renamed;
+  in.t_s = 0.5;
+  const LocalPlanResult r1 = lp.plan(in);
+  EXPECT_EQ(r1.status, LocalPlanStatus::kKeep) << r1.replan_reason;
+  EXPECT_EQ(r1.target_cluster, 100000);
+
+  // That frontier observed: every cluster with a node within track_radius_m (1 m) of the
+  // target's nodes removed, the others left: replanned.
+  std::vector<Eigen::Vector3f> target_nodes;
+  for (const auto& c : renamed)
+    if (c.id == 100000)
+      for (auto n : c.nodes) target_nodes.push_back(h.graph.node(n).p_m);
+  std::vector<storey::core::graph::FrontierCluster> gone;
+  for (const auto& c : renamed) {
+    bool near = false;
+    for (auto n : c.nodes)
+      for (const Eigen::Vector3f& q : target_nodes)
+        near = near || (h.graph.node(n).p_m - q).head<2>().norm() <= 1.2f;
+    if (!near) gone.push_back(c);
+  }
+  ASSERT_FALSE(gone.empty());
+  in.clusters = &gone;
+  in.t_s = 1.0;
+  const LocalPlanResult r2 = lp.plan(in);
+  EXPECT_NE(r2.status, LocalPlanStatus::kKeep);
+  EXPECT_STREQ(r2.replan_reason, "target cluster observed");
+  EXPECT_NE(r2.target_cluster, 100000);
+}
