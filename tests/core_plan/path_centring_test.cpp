@@ -120,7 +120,9 @@ TEST(PathCentring, FlightIsWalkedOnItsAxisAfterARunUp) {
   ASSERT_GE(foot, 1u);
   for (size_t i = foot - 1; i < path.size(); ++i) {
     EXPECT_LT(std::abs(path[i].y()), 0.15) << i << ": " << path[i].transpose();
-    if (i > foot) EXPECT_GE(path[i].z(), path[i - 1].z() - 0.03) << i;
+    if (i > foot) {
+      EXPECT_GE(path[i].z(), path[i - 1].z() - 0.03) << i;
+    }
   }
   EXPECT_LT(std::abs(path[foot - 1].z()), 0.05);
   const RobotModel robot;

@@ -46,7 +46,7 @@ TEST(ExplorationPlanner, FloorChangeBuildsThePriorOnlyWithUsePrior) {
     ExplorationPlanner planner({}, opt, 0.1);
     double t = 0;
     // Explore floor 0 a little.
-    for (const Eigen::Vector3f foot : {Eigen::Vector3f(1, 2, 0), Eigen::Vector3f(4, 2, 0)}) {
+    for (const Eigen::Vector3f& foot : {Eigen::Vector3f(1, 2, 0), Eigen::Vector3f(4, 2, 0)}) {
       h.observe(w, foot, 20000, uint32_t(t * 10) + 1);
       const auto view = h.map.view();
       const ExplorationResult r = planner.plan(input(h, view, foot, t));
@@ -107,7 +107,9 @@ TEST(ExplorationPlanner, CompleteWhenNoFrontiersAndNoZonesRemain) {
   EXPECT_NE(std::string(r.reason).find("no uncompleted zone"), std::string::npos);
   // With frontiers present the planner is not complete.
   const ExplorationResult r2 = planner.plan(input(h, view, foot, 1.0));
-  if (!h.clusters.clusters().empty()) EXPECT_NE(r2.status, ExplorationStatus::kComplete);
+  if (!h.clusters.clusters().empty()) {
+    EXPECT_NE(r2.status, ExplorationStatus::kComplete);
+  }
 }
 
 TEST(ExplorationPlanner, BadInputIsAFailureWithAReason) {
