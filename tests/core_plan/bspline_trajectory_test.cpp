@@ -220,7 +220,8 @@ TEST(BsplineTrajectory, WalksDownAFlightItStandsOnBackwards) {
   VoxelAStar astar(VoxelAStarOptions{.reachable_only = false});
   CollisionChecker cc(robot, view.voxel_size_m());
   TrajectoryBuilder tb(robot, TrajectoryOptions{.reachable_only = false});
-  for (const Eigen::Vector3d& start : {Eigen::Vector3d(2.35, 0, 0.75), Eigen::Vector3d(4, 0, 0.9)}) {
+  for (const Eigen::Vector3d& start :
+       {Eigen::Vector3d(2.35, 0, 0.75), Eigen::Vector3d(4, 0, 0.9)}) {
     const bool on_flight = start.x() < 2.8;
     const VoxelPath vp = astar.plan(view, start, {-1, 0, 0});
     ASSERT_EQ(vp.status, VoxelAStarStatus::kOk) << to_string(vp.status);
