@@ -23,6 +23,12 @@ World corridor() {
   return w;
 }
 
+// One scan of w from foot; true if it left frontier clusters at both ends.
+bool scan_from(Harness& h, const World& w, const Eigen::Vector3f& foot) {
+  h.observe(w, foot, 40000, 1);
+  return h.clusters.clusters().size() >= 2u;
+}
+
 LocalPlanInput input(const Harness& h, const storey::core::map::MapView& view,
                      const Eigen::Vector3f& foot, double t) {
   LocalPlanInput in;
@@ -74,8 +80,7 @@ TEST(LocalPlanner, SetAsideStaysOnAnUnchangedMapAndExpiresWhereTheMapChanges) {
   const World w = corridor();
   Harness h;
   const Eigen::Vector3f foot(0, 0, 0);
-  h.observe(w, foot, 40000, 1);
-  ASSERT_GE(h.clusters.clusters().size(), 2u);
+  ASSERT_TRUE(scan_from(h, w, foot));
   LocalPlanner lp(RobotModel{}, PlanOptions{}, 0.1);
   const SetAside s = set_aside_one(lp, h, foot);
   ASSERT_FALSE(s.p.empty());
@@ -143,8 +148,7 @@ TEST(LocalPlanner, TargetIsKeptWhenItsClusterOnlyChangedItsId) {
   const World w = corridor();
   Harness h;
   const Eigen::Vector3f foot(0, 0, 0);
-  h.observe(w, foot, 40000, 1);
-  ASSERT_GE(h.clusters.clusters().size(), 2u);
+  ASSERT_TRUE(scan_from(h, w, foot));
   LocalPlanner lp(RobotModel{}, PlanOptions{}, 0.1);
   const auto view = h.map.view();
   // Planned from off the scan origin, so the first viewpoint is not where the robot stands.
