@@ -40,6 +40,7 @@ class BaselinePolicy final : public ExplorationPolicy {
     return planner_.plan(in);
   }
   void drop_target() override { planner_.drop_target(); }
+  int64_t goals_set_aside() const override { return int64_t(planner_.driver().set_aside_count()); }
 
  private:
   const char* name_;

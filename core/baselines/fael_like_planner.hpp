@@ -54,6 +54,7 @@ class FaelLikePlanner {
                   const BaselineOptions& options = {});
   plan::ExplorationResult plan(const plan::ExplorationInput& in);
   void drop_target() { driver_.drop_target(); }
+  const GoalDriver& driver() const { return driver_; }
   const TraversabilityGrid2D& grid() const { return grid_; }
   // Goals of one cycle on the start floor's plane (grid Dijkstra path each), best first.
   std::vector<Goal> goals(const plan::ExplorationInput& in);

@@ -92,6 +92,22 @@ TEST(ExploreHouse, BothFloorsWithTheBlindClimb) {
   EXPECT_EQ(m.coverage_over_time, b.metrics.coverage_over_time);
 }
 
+// A baseline's run ends with its own reason: the goals it set aside, not the storey method's
+// frontier clusters (which it never schedules).
+TEST(ExploreHouse, ABaselineEndsNamingItsOwnSetAsideGoals) {
+  SimRunOptions o;
+  o.scene = "house";
+  o.method = "nearest-frontier";
+  o.time_limit_s = 300;
+  o.progress_period_s = 0;
+  o.progress = [](const std::string&) {};
+  const SimRunResult a = run_exploration(o);
+  ASSERT_TRUE(a.completed) << a.end_reason;
+  EXPECT_NE(a.end_reason.find("(nearest-frontier: "), std::string::npos) << a.end_reason;
+  EXPECT_NE(a.end_reason.find(" goals set aside)"), std::string::npos) << a.end_reason;
+  EXPECT_EQ(a.end_reason.find("clusters"), std::string::npos) << a.end_reason;
+}
+
 // Methods and ablations are all available; what is refused is unknown names and an ablation
 // (a switch of the storey method) combined with a baseline.
 TEST(ExploreHouse, RefusesBadMethodAndAblation) {

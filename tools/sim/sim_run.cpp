@@ -366,11 +366,16 @@ SimRunResult run_exploration(const SimRunOptions& opt) {
       if (done) {
         res.completed = true;
         char why[320];
-        std::snprintf(why, sizeof why,
-                      "exploration complete at %.1f s: %s (%u clusters, %u set aside as "
-                      "unobservable, %u unreachable)",
-                      t, st.plan_reason, st.clusters, st.clusters_set_aside,
-                      st.clusters_unreachable);
+        if (st.goals_set_aside >= 0)  // a baseline: its own goals, not the storey clusters
+          std::snprintf(why, sizeof why,
+                        "exploration complete at %.1f s: %s (%s: %lld goals set aside)", t,
+                        st.plan_reason, st.method, (long long)st.goals_set_aside);
+        else
+          std::snprintf(why, sizeof why,
+                        "exploration complete at %.1f s: %s (%u clusters, %u set aside as "
+                        "unobservable, %u unreachable)",
+                        t, st.plan_reason, st.clusters, st.clusters_set_aside,
+                        st.clusters_unreachable);
         res.end_reason = why;
         break;
       }
