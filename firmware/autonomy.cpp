@@ -380,7 +380,11 @@ void Autonomy::plan_step() {
   s.edges = uint32_t(w.graph.edge_count());
   s.frontier_nodes = w.frontier_nodes;
   s.clusters = uint32_t(w.clusters.size());
-  s.goals_set_aside = policy_->goals_set_aside();
+  if (const auto* g = policy_->goals_set_aside()) {
+    s.goals_stood_at = int32_t(g->stood_at);
+    s.goals_overdue = int32_t(g->overdue);
+    s.goals_no_trajectory = int32_t(g->no_trajectory);
+  }
   s.trajectories = trajectories_;
   s.plan_cycles = plan_cycles_;
   s.floor_hint = int(std::lround(pose.z_m / opt_.params.graph.floor_height_hint_m));

@@ -70,7 +70,8 @@ struct ExplorationStatus {
   // Clusters whose every node the local layer set aside / with no node connected to the robot
   // through G_real (computed by the plan task when the policy has nothing to do).
   uint32_t clusters_set_aside = 0, clusters_unreachable = 0;
-  int64_t goals_set_aside = -1;  // a baseline's own set-aside goals (-1: the storey method)
+  // A baseline's own set-aside goals (GoalDriver::SetAsideCounts; all -1 for the storey method).
+  int32_t goals_stood_at = -1, goals_overdue = -1, goals_no_trajectory = -1;
   uint64_t trajectories = 0, plan_cycles = 0;
   int floor_hint = 0;  // round(robot z / floor_height_hint_m)
   // Macro layer (storey method; -1 / 0 for the baselines): the robot's floor and its reference

@@ -40,7 +40,9 @@ class BaselinePolicy final : public ExplorationPolicy {
     return planner_.plan(in);
   }
   void drop_target() override { planner_.drop_target(); }
-  int64_t goals_set_aside() const override { return int64_t(planner_.driver().set_aside_count()); }
+  const core::baselines::GoalDriver::SetAsideCounts* goals_set_aside() const override {
+    return &planner_.driver().set_aside_counts();
+  }
 
  private:
   const char* name_;

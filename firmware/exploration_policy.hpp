@@ -13,12 +13,12 @@
 // Every policy answers with core::plan::ExplorationResult (kNewTrajectory / kKeep / kExploring
 // / kComplete / kFailed); the plan task publishes, holds or ends the run from that alone.
 // Single-threaded: owned and called by the plan task only.
-#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "config/parameters.hpp"
+#include "core/baselines/goal_driver.hpp"
 #include "core/plan/exploration_planner.hpp"
 
 namespace storey::firmware {
@@ -37,9 +37,11 @@ class ExplorationPolicy {
   virtual const core::plan::LocalPlanner* local_layer() const { return nullptr; }
   // The storey method's macro layer (floors, zones); nullptr for the baselines.
   virtual const core::plan::ExplorationPlanner* macro_layer() const { return nullptr; }
-  // A baseline's own goals set aside (stood there and still a goal, or Stage 3 failed
-  // repeatedly): why it ended; -1 for the storey method (its clusters are counted instead).
-  virtual int64_t goals_set_aside() const { return -1; }
+  // A baseline's own goals set aside, by why (why it ended); nullptr for the storey method (its
+  // clusters are counted instead).
+  virtual const core::baselines::GoalDriver::SetAsideCounts* goals_set_aside() const {
+    return nullptr;
+  }
 };
 
 // Known policy names, in the order of the DESIGN's command-line contract.

@@ -46,7 +46,10 @@ bool GoalDriver::keep(const plan::ExplorationInput& in, const std::vector<Goal>&
                        std::abs(in.robot_foot_m.z() - target_.p_m.z()) < 0.5;
   if (reached) {
     // Stood there and the frontier is still one: nothing more to see from reachable ground.
-    if (still_goal) add_set_aside(target_.key_m), add_set_aside(target_.p_m);
+    if (still_goal) {
+      add_set_aside(target_.key_m), add_set_aside(target_.p_m);
+      ++counts_.stood_at;
+    }
     has_target_ = false;
     return false;
   }
@@ -56,6 +59,7 @@ bool GoalDriver::keep(const plan::ExplorationInput& in, const std::vector<Goal>&
   }
   if (in.t_s > traj_end_s_ + opt_.overdue_s) {  // never arrived: blocked on the way
     add_set_aside(target_.key_m);
+    ++counts_.overdue;
     has_target_ = false;
     return false;
   }
@@ -147,6 +151,7 @@ void GoalDriver::choose(const plan::ExplorationInput& in, std::vector<Goal>& goa
     if (++it->second >= opt_.max_failures) {
       add_set_aside(g.key_m);
       add_set_aside(g.p_m);
+      ++counts_.no_trajectory;
       failures_.erase(it);
     }
   }

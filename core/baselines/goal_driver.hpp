@@ -71,7 +71,13 @@ class GoalDriver {
   bool set_aside(const Goal& g) const;  // its key or its standing point
   void drop_target() { has_target_ = false; }
   bool has_target() const { return has_target_; }
-  size_t set_aside_count() const { return set_aside_.size(); }
+  // Goals set aside, by why: stood there and still a goal / never arrived (overdue_s) / Stage 3
+  // failed max_failures times. The run record's end reason names them.
+  struct SetAsideCounts {
+    uint32_t stood_at = 0, overdue = 0, no_trajectory = 0;
+    uint32_t total() const { return stood_at + overdue + no_trajectory; }
+  };
+  const SetAsideCounts& set_aside_counts() const { return counts_; }
   plan::VoxelAStar& astar() { return astar_; }
   // Optional path filter (tare-like: no climbs steeper than its link rule); false rejects.
   void set_path_filter(std::function<bool(const std::vector<Eigen::Vector3d>&)> filter) {
@@ -92,6 +98,7 @@ class GoalDriver {
   Goal target_;
   double planned_at_s_ = 0, traj_end_s_ = 0;
   std::vector<Eigen::Vector3d> set_aside_;
+  SetAsideCounts counts_;
   std::vector<std::pair<Eigen::Vector3d, int>> failures_;
 };
 

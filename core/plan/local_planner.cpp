@@ -206,64 +206,32 @@ bool LocalPlanner::free_start(const LocalPlanInput& in) {
   return std::isfinite(best);
 }
 
-bool LocalPlanner::can_turn(const map::MapView& view, const Eigen::Vector3d& foot, double yaw) {
-  constexpr int kYaws = 24;  // 15 deg
-  BodyPose p[kYaws];
-  for (int k = 0; k < kYaws; ++k) p[k] = BodyPose{foot, yaw + 2.0 * M_PI * k / kYaws, 0.0, 0.0};
-  return !checker_.check_poses(view, std::span<const BodyPose>(p, kYaws)).collides;
-}
-
-// A straight step at constant yaw (the legs walk sideways or backwards as well) to the nearest
-// pose within escape_turn_radius_m where the body can turn on the spot.
+// A straight step to the nearest pose where the body can turn (escape.hpp), from the Stage 3
+// start; with away_from, one that gains distance from that point.
 bool LocalPlanner::escape(const LocalPlanInput& in, LocalPlanResult& out,
                           const Eigen::Vector3f* away_from) {
-  if (!away_from && can_turn(*in.view, start_foot_m_, start_yaw_)) return false;
-  auto dist_xy = [&](const Eigen::Vector3d& p) {
-    return (p.head<2>() - away_from->head<2>().cast<double>()).norm();
-  };
-  constexpr int kDirs = 16;
-  const double spacing = 0.1;
-  for (double d = 0.1; d <= opt_.escape_turn_radius_m + 1e-9; d += 0.1)
-    for (int a = 0; a < kDirs; ++a) {
-      const double th = 2.0 * M_PI * a / kDirs;
-      Eigen::Vector3d b = start_foot_m_ + Eigen::Vector3d(d * std::cos(th), d * std::sin(th), 0);
-      const auto s = in.view->support_surface_near(b.cast<float>(), robot_.step_height_m);
-      if (!s || !s->reachable) continue;
-      if (away_from && dist_xy(b) < dist_xy(start_foot_m_) + 0.5 * d) continue;
-      b.z() = s->height_m;
-      if (!can_turn(*in.view, b, start_yaw_)) continue;
-      std::vector<Eigen::Vector3d> pts;
-      const int n = std::max(1, int(std::ceil(d / spacing)));
-      for (int j = 0; j <= n; ++j)
-        pts.push_back(start_foot_m_ + (b - start_foot_m_) * (double(j) / n));
-      if (straight_walk(in, pts, start_yaw_, out)) return true;
-    }
-  return false;
+  if (!away_from && can_turn_at(checker_, *in.view, start_foot_m_, start_yaw_)) return false;
+  auto w = escape_to_turn(checker_, *in.view, robot_, start_foot_m_, start_yaw_, in.t_s,
+                          opt_.escape_turn_radius_m, away_from);
+  if (!w) return false;
+  take_walk(std::move(*w), start_yaw_, out);
+  return true;
 }
 
 bool LocalPlanner::straight_walk(const LocalPlanInput& in, const std::vector<Eigen::Vector3d>& pts,
                                  double yaw, LocalPlanResult& out) {
-  if (pts.size() < 2) return false;
-  std::vector<Eigen::Vector3d> c(2, pts.front());
-  c.insert(c.end(), pts.begin(), pts.end());
-  c.insert(c.end(), 2, pts.back());
-  double len = 0;
-  for (size_t j = 1; j < pts.size(); ++j) len += (pts[j] - pts[j - 1]).head<2>().norm();
-  const double seg = len / double(pts.size() - 1);
-  // Knot interval: half speed, and the acceleration limit at the tripled ends.
-  const double dt = std::max(seg / (0.5 * robot_.max_speed_mps),
-                             std::sqrt(seg / std::max(robot_.max_accel_mps2, 1e-3)));
-  const std::vector<double> yaws(c.size(), yaw);
-  BsplineTrajectory t(std::move(c), yaws, std::max(dt, 1e-3), in.t_s);
-  const CollisionHit hit = checker_.check_ahead(
-      *in.view, [&](double tt) { return t.pose(tt); }, t.t_start(), t.duration(), 0.0);
-  if (hit.collides) return false;
-  out.trajectory = std::move(t);
-  out.path_m = {pts.front(), pts.back()};
-  out.target_m = pts.back();
+  auto w = plan::straight_walk(checker_, *in.view, robot_, pts, yaw, in.t_s);
+  if (!w) return false;
+  take_walk(std::move(*w), yaw, out);
+  return true;
+}
+
+void LocalPlanner::take_walk(StraightWalk&& w, double yaw, LocalPlanResult& out) {
+  out.trajectory = std::move(w.trajectory);
+  out.path_m = {w.from_m, w.to_m};
+  out.target_m = w.to_m;
   out.target_yaw_rad = yaw;
   out.real_until_s = out.trajectory.t_end();
-  return true;
 }
 
 // On a flight the body pitches with the stairs and the LiDAR's +-15 deg look over the treads

@@ -31,6 +31,7 @@
 #include "core/map/map_view.hpp"
 #include "core/plan/bspline_trajectory.hpp"
 #include "core/plan/collision_checker.hpp"
+#include "core/plan/escape.hpp"
 #include "core/plan/graph_search.hpp"
 #include "core/plan/plan_options.hpp"
 #include "core/plan/stage_probe.hpp"
@@ -163,7 +164,6 @@ class LocalPlanner {
   void build_search_graph(const graph::ReachableGraph& g);
   // Stage 3 to one viewpoint; on failure *why says A* or trajectory.
   bool free_start(const LocalPlanInput& in);
-  bool can_turn(const map::MapView& view, const Eigen::Vector3d& foot, double yaw);
   // away_from: the start is boxed in by this obstacle: move away from it even if the body can
   // turn where it stands.
   bool escape(const LocalPlanInput& in, LocalPlanResult& out,
@@ -177,6 +177,7 @@ class LocalPlanner {
   // A straight walk at constant yaw through `pts` (foot points), checked against the map.
   bool straight_walk(const LocalPlanInput& in, const std::vector<Eigen::Vector3d>& pts, double yaw,
                      LocalPlanResult& out);
+  void take_walk(StraightWalk&& w, double yaw, LocalPlanResult& out);
 
   RobotModel robot_;
   PlanOptions plan_opt_;

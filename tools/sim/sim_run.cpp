@@ -366,10 +366,12 @@ SimRunResult run_exploration(const SimRunOptions& opt) {
       if (done) {
         res.completed = true;
         char why[320];
-        if (st.goals_set_aside >= 0)  // a baseline: its own goals, not the storey clusters
+        if (st.goals_stood_at >= 0)  // a baseline: its own goals, not the storey clusters
           std::snprintf(why, sizeof why,
-                        "exploration complete at %.1f s: %s (%s: %lld goals set aside)", t,
-                        st.plan_reason, st.method, (long long)st.goals_set_aside);
+                        "exploration complete at %.1f s: %s (%s: goals set aside: %d stood at, "
+                        "%d overdue, %d without a trajectory)",
+                        t, st.plan_reason, st.method, st.goals_stood_at, st.goals_overdue,
+                        st.goals_no_trajectory);
         else
           std::snprintf(why, sizeof why,
                         "exploration complete at %.1f s: %s (%u clusters, %u set aside as "

@@ -1,0 +1,65 @@
+#include "core/plan/escape.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <span>
+
+namespace storey::core::plan {
+
+bool can_turn_at(CollisionChecker& checker, const map::MapView& view, const Eigen::Vector3d& foot,
+                 double yaw) {
+  constexpr int kYaws = 24;  // 15 deg
+  BodyPose p[kYaws];
+  for (int k = 0; k < kYaws; ++k) p[k] = BodyPose{foot, yaw + 2.0 * M_PI * k / kYaws, 0.0, 0.0};
+  return !checker.check_poses(view, std::span<const BodyPose>(p, kYaws)).collides;
+}
+
+std::optional<StraightWalk> straight_walk(CollisionChecker& checker, const map::MapView& view,
+                                          const RobotModel& robot,
+                                          const std::vector<Eigen::Vector3d>& pts, double yaw,
+                                          double t0) {
+  if (pts.size() < 2) return std::nullopt;
+  std::vector<Eigen::Vector3d> c(2, pts.front());
+  c.insert(c.end(), pts.begin(), pts.end());
+  c.insert(c.end(), 2, pts.back());
+  double len = 0;
+  for (size_t j = 1; j < pts.size(); ++j) len += (pts[j] - pts[j - 1]).head<2>().norm();
+  const double seg = len / double(pts.size() - 1);
+  // Knot interval: half speed, and the acceleration limit at the tripled ends.
+  const double dt = std::max(seg / (0.5 * robot.max_speed_mps),
+                             std::sqrt(seg / std::max(robot.max_accel_mps2, 1e-3)));
+  const std::vector<double> yaws(c.size(), yaw);
+  BsplineTrajectory t(std::move(c), yaws, std::max(dt, 1e-3), t0);
+  const CollisionHit hit = checker.check_ahead(
+      view, [&](double tt) { return t.pose(tt); }, t.t_start(), t.duration(), 0.0);
+  if (hit.collides) return std::nullopt;
+  return StraightWalk{std::move(t), pts.front(), pts.back()};
+}
+
+std::optional<StraightWalk> escape_to_turn(CollisionChecker& checker, const map::MapView& view,
+                                           const RobotModel& robot, const Eigen::Vector3d& start,
+                                           double yaw, double t0, double radius_m,
+                                           const Eigen::Vector3f* away_from) {
+  auto dist_xy = [&](const Eigen::Vector3d& p) {
+    return (p.head<2>() - away_from->head<2>().cast<double>()).norm();
+  };
+  constexpr int kDirs = 16;
+  const double spacing = 0.1;
+  for (double d = 0.1; d <= radius_m + 1e-9; d += 0.1)
+    for (int a = 0; a < kDirs; ++a) {
+      const double th = 2.0 * M_PI * a / kDirs;
+      Eigen::Vector3d b = start + Eigen::Vector3d(d * std::cos(th), d * std::sin(th), 0);
+      const auto s = view.support_surface_near(b.cast<float>(), robot.step_height_m);
+      if (!s || !s->reachable) continue;
+      if (away_from && dist_xy(b) < dist_xy(start) + 0.5 * d) continue;
+      b.z() = s->height_m;
+      if (!can_turn_at(checker, view, b, yaw)) continue;
+      std::vector<Eigen::Vector3d> pts;
+      const int n = std::max(1, int(std::ceil(d / spacing)));
+      for (int j = 0; j <= n; ++j) pts.push_back(start + (b - start) * (double(j) / n));
+      if (auto w = straight_walk(checker, view, robot, pts, yaw, t0)) return w;
+    }
+  return std::nullopt;
+}
+
+}  // namespace storey::core::plan

@@ -1,0 +1,44 @@
+#pragma once
+// Getting a long body out of a place it cannot turn in: a straight step at constant yaw (the
+// legs walk sideways or backwards as well) to the nearest pose where the body turns on the spot.
+// Stage-3 machinery shared by the paper's local layer (LocalPlanner) and the baselines
+// (GoalDriver): in a corridor narrower than the body's turning circle every path that starts
+// with a turn collides, however good the target.
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/map/map_view.hpp"
+#include "core/plan/bspline_trajectory.hpp"
+#include "core/plan/collision_checker.hpp"
+#include "core/robot_model.hpp"
+
+namespace storey::core::plan {
+
+// The body turns on the spot at foot: 24 yaws (15 deg apart) from yaw, none colliding.
+bool can_turn_at(CollisionChecker& checker, const map::MapView& view, const Eigen::Vector3d& foot,
+                 double yaw);
+
+// A straight walk: its trajectory and its end points (the first and last of the points given).
+struct StraightWalk {
+  BsplineTrajectory trajectory;
+  Eigen::Vector3d from_m = Eigen::Vector3d::Zero(), to_m = Eigen::Vector3d::Zero();
+};
+
+// A B-spline through pts at constant yaw, starting at t0 (knots at half the speed limit and the
+// acceleration limit at the ends), collision-checked; nullopt if it collides.
+std::optional<StraightWalk> straight_walk(CollisionChecker& checker, const map::MapView& view,
+                                          const RobotModel& robot,
+                                          const std::vector<Eigen::Vector3d>& pts, double yaw,
+                                          double t0);
+
+// The straight step from start (yaw kept) to the nearest reachable pose within radius_m where
+// the body can turn, nearest first (0.1 m rings, 16 directions); with away_from, only poses that
+// gain distance from that point (at least half the step). nullopt: none.
+std::optional<StraightWalk> escape_to_turn(CollisionChecker& checker, const map::MapView& view,
+                                           const RobotModel& robot, const Eigen::Vector3d& start,
+                                           double yaw, double t0, double radius_m,
+                                           const Eigen::Vector3f* away_from = nullptr);
+
+}  // namespace storey::core::plan
