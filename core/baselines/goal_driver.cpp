@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/plan/escape.hpp"
 #include "core/plan/path_centring.hpp"
 #include "core/plan/plan_config.hpp"
 
@@ -135,6 +136,7 @@ void GoalDriver::choose(const plan::ExplorationInput& in, std::vector<Goal>& goa
   std::stable_sort(goals.begin(), goals.end(),
                    [](const Goal& a, const Goal& b) { return a.cost < b.cost; });
   int attempts = 0;
+  std::vector<const Goal*> failed;
   for (const Goal& g : goals) {
     if (attempts++ >= opt_.max_attempts) break;
     if (drive(in, g, r)) {
@@ -145,6 +147,25 @@ void GoalDriver::choose(const plan::ExplorationInput& in, std::vector<Goal>& goa
       r.reason = "new frontier target";
       return;
     }
+    failed.push_back(&g);
+  }
+  // As the local layer does: where the body cannot turn on the spot (a corridor narrower than
+  // its turning circle) every path starting with a turn fails, whatever the goal; step straight
+  // to the nearest place where it can turn and try again from there (the goals are not blamed).
+  if (!failed.empty() && !plan::can_turn_at(checker_, *in.view, in.robot_foot_m, in.robot_yaw_rad))
+    if (auto w = plan::escape_to_turn(checker_, *in.view, robot_, in.robot_foot_m, in.robot_yaw_rad,
+                                      in.t_s, opt_.escape_turn_radius_m)) {
+      has_target_ = false;
+      r.status = plan::ExplorationStatus::kNewTrajectory;
+      r.trajectory = std::move(w->trajectory);
+      r.real_until_s = r.trajectory.t_end();
+      r.target_m = w->to_m;
+      r.target_yaw_rad = in.robot_yaw_rad;
+      r.reason = "escape: cannot turn here";
+      return;
+    }
+  for (const Goal* gp : failed) {
+    const Goal& g = *gp;
     auto it = std::find_if(failures_.begin(), failures_.end(),
                            [&](const auto& f) { return near(f.first, g.key_m, 0.3); });
     if (it == failures_.end()) it = failures_.insert(failures_.end(), {g.key_m, 0});

@@ -28,6 +28,8 @@ struct BaselineOptions {
   int max_failures = 2;               // Stage 3 failures before a goal is set aside
   int max_attempts = 6;               // Stage 3 attempts per cycle (bounded work)
   double overdue_s = 10.0;            // trajectory ended this long ago without arrival: set aside
+  double escape_turn_radius_m = 0.8;  // cannot turn on the spot: a turning place this far
+                                      // (LocalPlannerOptions::escape_turn_radius_m)
   int min_cluster_cells = 4;          // smaller frontier clusters are noise (nearest-frontier,
                                       // fael-like)
   double height_threshold_m = 0.3;    // tare-like: largest height difference of a link [m] ...

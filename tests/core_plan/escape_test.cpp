@@ -1,0 +1,54 @@
+// The shared escape (core/plan/escape.hpp): out of a corridor narrower than the body's turning
+// circle, straight into the room it opens into.
+#include "core/plan/escape.hpp"
+
+#include <gtest/gtest.h>
+
+#include "tests/core_plan/voxel_world.hpp"
+
+namespace storey::core::plan {
+namespace {
+
+// A 0.6 m corridor along x (x < 0) opening into a 4 x 4 m room (x > 0).
+map::TraversabilityMap corridor_into_room() {
+  storey::test::World w;
+  w.add(storey::test::aabb({-3, -2, -0.2f}, {4, 2, 0}));  // floor
+  w.add(storey::test::aabb({-3, -0.5f, 0}, {0, -0.3f, 1.5f}));
+  w.add(storey::test::aabb({-3, 0.3f, 0}, {0, 0.5f, 1.5f}));
+  w.add(storey::test::aabb({-0.2f, -2, 0}, {0, -0.5f, 1.5f}));  // room wall beside the mouth
+  w.add(storey::test::aabb({-0.2f, 0.5f, 0}, {0, 2, 1.5f}));
+  w.add(storey::test::aabb({4, -2, 0}, {4.2f, 2, 1.5f}));
+  w.add(storey::test::aabb({-0.2f, -2.2f, 0}, {4, -2, 1.5f}));
+  w.add(storey::test::aabb({-0.2f, 2, 0}, {4, 2.2f, 1.5f}));
+  map::TraversabilityMap m;
+  storey::test::scan_world(m, w, {{-0.3f, 0, 0.5f}, {1.5f, 0, 0.5f}, {-1.5f, 0, 0.5f}});
+  return m;
+}
+
+TEST(Escape, OutOfACorridorTooNarrowToTurnInIntoTheRoom) {
+  const map::TraversabilityMap m = corridor_into_room();
+  const map::MapView view = m.view();
+  const RobotModel robot;
+  CollisionChecker checker(robot, view.voxel_size_m());
+  const Eigen::Vector3d start(-0.3, 0, 0);
+  ASSERT_FALSE(checker.check_poses(view, std::vector<BodyPose>{{start, 0.0, 0.0, 0.0}}).collides);
+  EXPECT_FALSE(can_turn_at(checker, view, start, 0.0));
+  EXPECT_TRUE(can_turn_at(checker, view, {1.5, 0, 0}, 0.0));
+
+  const auto w = escape_to_turn(checker, view, robot, start, 0.0, 10.0, 1.2);
+  ASSERT_TRUE(w.has_value());
+  EXPECT_EQ(w->from_m, start);
+  EXPECT_GT(w->to_m.x(), 0.2);  // in the room
+  EXPECT_LT((w->to_m - start).head<2>().norm(), 1.2 + 1e-9);
+  EXPECT_TRUE(can_turn_at(checker, view, w->to_m, 0.0));
+  EXPECT_DOUBLE_EQ(w->trajectory.t_start(), 10.0);
+  EXPECT_NEAR(w->trajectory.pose(w->trajectory.t_end()).yaw_rad, 0.0, 1e-9);  // yaw kept
+
+  // No turning place within reach: none.
+  EXPECT_FALSE(escape_to_turn(checker, view, robot, start, 0.0, 10.0, 0.3).has_value());
+  // Where it can turn already, the nearest turning place is a step away (callers check first).
+  EXPECT_TRUE(escape_to_turn(checker, view, robot, {1.5, 0, 0}, 0.0, 0.0, 0.5).has_value());
+}
+
+}  // namespace
+}  // namespace storey::core::plan
