@@ -98,8 +98,13 @@ bool GoalDriver::drive(const plan::ExplorationInput& in, const Goal& g,
   std::vector<Eigen::Vector3d> path = g.path_m;
   if (path.empty() || start != in.robot_foot_m) {
     plan::VoxelPath vp = astar_.plan(*in.view, start, g.p_m);
-    if (vp.status != plan::VoxelAStarStatus::kOk || vp.points_m.empty()) return false;
-    path = std::move(vp.points_m);
+    if (vp.status == plan::VoxelAStarStatus::kOk && !vp.points_m.empty())
+      path = std::move(vp.points_m);
+    else if (fallback_)
+      path = fallback_(in, g);
+    else
+      path.clear();
+    if (path.empty()) return false;
   }
   path.front() = start;
   if (filter_ && !filter_(path)) return false;

@@ -48,6 +48,7 @@ struct Goal {
   Eigen::Vector3d key_m = Eigen::Vector3d::Zero();  // the frontier's position (set-aside key)
   double cost = 0;                                  // the method's ordering cost (lower first)
   std::vector<Eigen::Vector3d> path_m;  // support polyline from the robot (empty: voxel A*)
+  uint32_t node = UINT32_MAX;           // its graph node, if the method has one (fallback paths)
 };
 
 class GoalDriver {
@@ -85,6 +86,13 @@ class GoalDriver {
   void set_path_filter(std::function<bool(const std::vector<Eigen::Vector3d>&)> filter) {
     filter_ = std::move(filter);
   }
+  // Optional path where the voxel A* finds none (tare-like: along its own viewpoint graph, as
+  // TARE plans; on a sparsely seen ramp the voxel A* fails where the graph still connects).
+  // Returns support points from near the robot to the goal, or none.
+  void set_fallback_path(
+      std::function<std::vector<Eigen::Vector3d>(const plan::ExplorationInput&, const Goal&)> f) {
+    fallback_ = std::move(f);
+  }
 
  private:
   void add_set_aside(const Eigen::Vector3d& key_m) { set_aside_.push_back(key_m); }
@@ -95,6 +103,7 @@ class GoalDriver {
   plan::TrajectoryBuilder builder_;
   plan::CollisionChecker checker_;
   std::function<bool(const std::vector<Eigen::Vector3d>&)> filter_;
+  std::function<std::vector<Eigen::Vector3d>(const plan::ExplorationInput&, const Goal&)> fallback_;
   // Current target.
   bool has_target_ = false;
   Goal target_;

@@ -37,6 +37,17 @@ TareLikePlanner::TareLikePlanner(const RobotModel& robot, const plan::PlanOption
   const double th = options.height_threshold_m, sp = options.link_spacing_m;
   driver_.set_path_filter(
       [th, sp](const std::vector<Eigen::Vector3d>& p) { return tare_path_ok(p, th, sp); });
+  // Its own viewpoint graph (this cycle's, built by goals()) where the voxel A* finds no path.
+  driver_.set_fallback_path([this](const plan::ExplorationInput& in, const Goal& goal) {
+    std::vector<Eigen::Vector3d> path;
+    if (robot_node_ >= sg_.num_nodes() || goal.node >= sg_.num_nodes()) return path;
+    const plan::PathResult r = path_search_.astar(sg_, robot_node_, goal.node);
+    if (!r.found) return path;
+    path.push_back(in.robot_foot_m);
+    for (uint32_t u : r.nodes) path.push_back(sg_.position(u));
+    if ((path.back() - goal.p_m).norm() > 1e-6) path.push_back(goal.p_m);
+    return path;
+  });
 }
 
 std::vector<Goal> TareLikePlanner::goals(const plan::ExplorationInput& in) {
@@ -59,10 +70,12 @@ std::vector<Goal> TareLikePlanner::goals(const plan::ExplorationInput& in) {
     edges.push_back({ge.a, ge.b, double(std::max(ge.cost, ge.length_m))});
   }
   sg_ = plan::SearchGraph::from_edges(pos, edges, true);
+  robot_node_ = UINT32_MAX;
   uint32_t robot = g.root();
   if (robot == graph::kNoId || !g.node(robot).alive)
     robot = g.nearest(in.robot_foot_m.cast<float>(), 1.5f, 1.0f);
   if (robot == graph::kNoId) return out;
+  robot_node_ = robot;
   search_.dijkstra(sg_, std::span<const uint32_t>(&robot, 1));
 
   // Reachable clusters: representative = reachable member nearest the centroid.
@@ -132,6 +145,7 @@ std::vector<Goal> TareLikePlanner::goals(const plan::ExplorationInput& in) {
       Goal goal;
       goal.key_m = pos[c.rep];
       goal.p_m = pos[c.rep];
+      goal.node = c.rep;
       Eigen::Vector3d look = fc.centroid_m.cast<double>() - goal.p_m;
       for (const graph::ClusterViewpoints& cv : *in.viewpoints) {
         if (cv.cluster_id != fc.id) continue;
@@ -139,6 +153,7 @@ std::vector<Goal> TareLikePlanner::goals(const plan::ExplorationInput& in) {
           if (v.node < g.node_capacity() && g.node(v.node).alive &&
               std::isfinite(search_.dist(v.node))) {
             goal.p_m = v.p_m.cast<double>();
+            goal.node = v.node;
             look = Eigen::Vector3d(std::cos(v.yaw_rad), std::sin(v.yaw_rad), 0);
             break;
           }

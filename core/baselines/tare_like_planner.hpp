@@ -42,8 +42,9 @@ class TareLikePlanner {
   BaselineOptions opt_;
   GoalDriver driver_;
   plan::TspSolver tsp_;
-  plan::GraphSearch search_;
+  plan::GraphSearch search_, path_search_;
   plan::SearchGraph sg_;
+  uint32_t robot_node_ = UINT32_MAX;  // this cycle's robot node on sg_
   size_t kept_ = 0, refused_ = 0;
 };
 

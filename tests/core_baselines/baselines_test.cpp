@@ -139,6 +139,39 @@ TEST(TareLike, RefusesThePathUpAStairFlight) {
   EXPECT_TRUE(tare_path_ok(flat.points_m, 0.3, 1.0));
 }
 
+// GoalDriver's fallback path (tare-like: its own viewpoint graph) is taken only where the voxel
+// A* finds no path, and the trajectory then follows it.
+TEST(GoalDriver, FallbackPathOnlyWhereTheVoxelAStarFails) {
+  World w;
+  w.add(aabb({-6, -1.5f, -0.2f}, {6, 1.5f, 0}));
+  w.add(aabb({-6, -1.7f, 0}, {6, -1.5f, 2.5f}));
+  w.add(aabb({-6, 1.5f, 0}, {6, 1.7f, 2.5f}));
+  map::TraversabilityMap m;
+  scan(m, w, {{0, 0, 0.5f}, {3, 0, 0.5f}}, 6.0f);
+  const map::MapView view = m.view();
+  const plan::ExplorationInput in = input_at(view, {0, 0, 0});
+  GoalDriver d(RobotModel{}, plan::PlanOptions{}, 0.1, BaselineOptions{});
+  int calls = 0;
+  d.set_fallback_path([&](const plan::ExplorationInput& i, const Goal&) {
+    ++calls;
+    return std::vector<Eigen::Vector3d>{i.robot_foot_m, {1.5, 0, 0}, {3, 0, 0}};
+  });
+  Goal on_floor;
+  on_floor.p_m = {3, 0, 0};
+  plan::ExplorationResult r;
+  ASSERT_TRUE(d.drive(in, on_floor, r)) << r.reason;
+  EXPECT_EQ(calls, 0);  // the voxel A* found it
+  Goal in_the_air;      // no support under it: the voxel A* fails
+  in_the_air.p_m = {3, 0, 1.5};
+  plan::ExplorationResult f;
+  ASSERT_TRUE(d.drive(in, in_the_air, f));
+  EXPECT_EQ(calls, 1);
+  EXPECT_LT((f.trajectory.sample(f.trajectory.t_end()).p_m - Eigen::Vector3d(3, 0, 0)).norm(), 0.2);
+  GoalDriver plain(RobotModel{}, plan::PlanOptions{}, 0.1, BaselineOptions{});
+  plan::ExplorationResult n;
+  EXPECT_FALSE(plain.drive(in, in_the_air, n));
+}
+
 TEST(Baselines, BadInputFails) {
   plan::ExplorationInput in;
   NearestFrontierPlanner a(RobotModel{}, plan::PlanOptions{}, 0.1);
