@@ -81,20 +81,10 @@ bool GoalDriver::drive(const plan::ExplorationInput& in, const Goal& g,
   // a jamb seen late): every trajectory from there collides at its first pose. As the local
   // layer does, start from the nearest collision-free pose within 0.3 m instead (the control task
   // tracks from the point of a new trajectory nearest the robot).
-  Eigen::Vector3d start = in.robot_foot_m;
-  plan::BodyPose here{start, in.robot_yaw_rad, 0.0, in.t_s};
-  if (checker_.check_poses(*in.view, std::span<const plan::BodyPose>(&here, 1)).collides) {
-    bool found = false;
-    for (double d = 0.05; d <= 0.3 + 1e-9 && !found; d += 0.05)
-      for (int k = 0; k < 16 && !found; ++k) {
-        const double a = k * M_PI / 8;
-        plan::BodyPose p = here;
-        p.foot_m = in.robot_foot_m + d * Eigen::Vector3d(std::cos(a), std::sin(a), 0);
-        if (!checker_.check_poses(*in.view, std::span<const plan::BodyPose>(&p, 1)).collides)
-          start = p.foot_m, found = true;
-      }
-    if (!found) return false;
-  }
+  const auto free_start = plan::nearest_free_foot(
+      checker_, *in.view, plan::BodyPose{in.robot_foot_m, in.robot_yaw_rad, 0.0, in.t_s}, 0.3);
+  if (!free_start) return false;
+  const Eigen::Vector3d start = *free_start;
   std::vector<Eigen::Vector3d> path = g.path_m;
   if (path.empty() || start != in.robot_foot_m) {
     plan::VoxelPath vp = astar_.plan(*in.view, start, g.p_m);

@@ -62,4 +62,18 @@ std::optional<StraightWalk> escape_to_turn(CollisionChecker& checker, const map:
   return std::nullopt;
 }
 
+std::optional<Eigen::Vector3d> nearest_free_foot(CollisionChecker& checker,
+                                                 const map::MapView& view, const BodyPose& pose,
+                                                 double radius_m) {
+  if (!checker.check_poses(view, std::span<const BodyPose>(&pose, 1)).collides) return pose.foot_m;
+  for (double d = 0.05; d <= radius_m + 1e-9; d += 0.05)
+    for (int k = 0; k < 16; ++k) {
+      const double a = k * M_PI / 8;
+      BodyPose p = pose;
+      p.foot_m = pose.foot_m + d * Eigen::Vector3d(std::cos(a), std::sin(a), 0);
+      if (!checker.check_poses(view, std::span<const BodyPose>(&p, 1)).collides) return p.foot_m;
+    }
+  return std::nullopt;
+}
+
 }  // namespace storey::core::plan

@@ -41,4 +41,10 @@ std::optional<StraightWalk> escape_to_turn(CollisionChecker& checker, const map:
                                            double yaw, double t0, double radius_m,
                                            const Eigen::Vector3f* away_from = nullptr);
 
+// The pose itself if the body there is collision-free, else the nearest collision-free one at the
+// same yaw within radius_m (0.05 m rings, 16 directions, height kept); nullopt: none.
+std::optional<Eigen::Vector3d> nearest_free_foot(CollisionChecker& checker,
+                                                 const map::MapView& view, const BodyPose& pose,
+                                                 double radius_m);
+
 }  // namespace storey::core::plan

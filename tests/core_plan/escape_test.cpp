@@ -50,5 +50,25 @@ TEST(Escape, OutOfACorridorTooNarrowToTurnInIntoTheRoom) {
   EXPECT_TRUE(escape_to_turn(checker, view, robot, {1.5, 0, 0}, 0.0, 0.0, 0.5).has_value());
 }
 
+TEST(Escape, NearestFreeFootStepsAwayFromAWallItOverlaps) {
+  const map::TraversabilityMap m = corridor_into_room();
+  const map::MapView view = m.view();
+  CollisionChecker checker(RobotModel{}, view.voxel_size_m());
+  // In the room, yawed along the wall at y = 2 and 0.1 m from it: the box overlaps the wall.
+  const BodyPose by_wall{{2.0, 1.9, 0.0}, 0.0, 0.0, 0.0};
+  ASSERT_TRUE(checker.check_poses(view, std::vector<BodyPose>{by_wall}).collides);
+  const auto f = nearest_free_foot(checker, view, by_wall, 0.3);
+  ASSERT_TRUE(f.has_value());
+  EXPECT_LT(f->y(), 1.9);
+  EXPECT_LE((*f - by_wall.foot_m).norm(), 0.3 + 1e-9);
+  BodyPose q = by_wall;
+  q.foot_m = *f;
+  EXPECT_FALSE(checker.check_poses(view, std::vector<BodyPose>{q}).collides);
+  // A free pose is its own answer; one too deep in the wall has none within reach.
+  const BodyPose free{{2.0, 0.0, 0.0}, 0.0, 0.0, 0.0};
+  EXPECT_EQ(nearest_free_foot(checker, view, free, 0.3).value(), free.foot_m);
+  EXPECT_FALSE(nearest_free_foot(checker, view, {{2.0, 2.1, 0.0}, 0.0, 0.0, 0.0}, 0.1));
+}
+
 }  // namespace
 }  // namespace storey::core::plan
