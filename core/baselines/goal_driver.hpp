@@ -78,7 +78,6 @@ class GoalDriver {
   // failed max_failures times. The run record's end reason names them.
   struct SetAsideCounts {
     uint32_t stood_at = 0, overdue = 0, no_trajectory = 0;
-    uint32_t total() const { return stood_at + overdue + no_trajectory; }
   };
   const SetAsideCounts& set_aside_counts() const { return counts_; }
   plan::VoxelAStar& astar() { return astar_; }

@@ -25,6 +25,15 @@ void scan(map::TraversabilityMap& m, const World& w, const std::vector<Eigen::Ve
   m.update_reachable(origins.front() - Eigen::Vector3f(0, 0, 0.5f));
 }
 
+// A 3 m wide corridor along x, from -half_length to +half_length, walls 2.5 m high.
+World corridor_along_x(float half_length) {
+  World w;
+  w.add(aabb({-half_length, -1.5f, -0.2f}, {half_length, 1.5f, 0}));
+  w.add(aabb({-half_length, -1.7f, 0}, {half_length, -1.5f, 2.5f}));
+  w.add(aabb({-half_length, 1.5f, 0}, {half_length, 1.7f, 2.5f}));
+  return w;
+}
+
 plan::ExplorationInput input_at(const map::MapView& view, const Eigen::Vector3d& foot) {
   plan::ExplorationInput in;
   in.view = &view;
@@ -59,10 +68,7 @@ TEST(TareLink, RefusesAStepButAcceptsAGentleRamp) {
 // about x = -2 and x = 3.7, where the frontiers are. From x = 0 the -x one is nearer, from x = 2
 // the +x one.
 TEST(NearestFrontier, PicksTheNearerOfTwoFrontiers) {
-  World w;
-  w.add(aabb({-12, -1.5f, -0.2f}, {12, 1.5f, 0}));
-  w.add(aabb({-12, -1.7f, 0}, {12, -1.5f, 2.5f}));
-  w.add(aabb({-12, 1.5f, 0}, {12, 1.7f, 2.5f}));
+  const World w = corridor_along_x(12);
   map::TraversabilityMap m;
   scan(m, w, {{0, 0, 0.5f}, {2, 0, 0.5f}}, 4.0f);
   const map::MapView view = m.view();
@@ -142,10 +148,7 @@ TEST(TareLike, RefusesThePathUpAStairFlight) {
 // GoalDriver's fallback path (tare-like: its own viewpoint graph) is taken only where the voxel
 // A* finds no path, and the trajectory then follows it.
 TEST(GoalDriver, FallbackPathOnlyWhereTheVoxelAStarFails) {
-  World w;
-  w.add(aabb({-6, -1.5f, -0.2f}, {6, 1.5f, 0}));
-  w.add(aabb({-6, -1.7f, 0}, {6, -1.5f, 2.5f}));
-  w.add(aabb({-6, 1.5f, 0}, {6, 1.7f, 2.5f}));
+  const World w = corridor_along_x(6);
   map::TraversabilityMap m;
   scan(m, w, {{0, 0, 0.5f}, {3, 0, 0.5f}}, 6.0f);
   const map::MapView view = m.view();
