@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 
 namespace storey::core::graph {
 
@@ -357,9 +356,17 @@ NodeId ReachableGraph::attach_root(SupportQuery& q, const Eigen::Vector3f& foot,
                                    GraphUpdateStats& st) {
   const float r = float(opt_.root_radius_m);
   NodeId best = nearest(foot, r, q.step());
-  if (best != kNoId) return best;
+  std::optional<Support> s;
+  if (best != kNoId) {
+    const Eigen::Vector3f d = nodes_[best].p_m - foot;
+    if (!opt_.root_off_graph || std::abs(d.z()) <= 0.5f * q.step() ||
+        d.head<2>().norm() <= float(opt_.node_clearance_m))
+      return best;
+    s = q.support_dilated(foot.x(), foot.y(), foot.z(), 0.5f * q.step());
+    if (!s) return best;
+  }
   // The LiDAR cannot see under the body: look for support around the foot too.
-  std::optional<Support> s = q.support_dilated(foot.x(), foot.y(), foot.z(), q.step());
+  if (!s) s = q.support_dilated(foot.x(), foot.y(), foot.z(), q.step());
   for (int k = 0; k < 8 && !s; ++k) {
     const float a = float(k) * float(M_PI) / 4.0f;
     s = q.support_dilated(foot.x() + 0.5f * r * std::cos(a), foot.y() + 0.5f * r * std::sin(a),
@@ -367,7 +374,7 @@ NodeId ReachableGraph::attach_root(SupportQuery& q, const Eigen::Vector3f& foot,
   }
   if (!s) return kNoId;
   bool confirmed = false;
-  if (q.classify_node(*s, &confirmed) != Reject::kNone) return kNoId;
+  if (q.classify_node(*s, &confirmed) != Reject::kNone) return best;
   const NodeId id = add_node(*s, confirmed);
   ++st.nodes_added;
   scratch_.clear();

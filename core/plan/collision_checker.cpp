@@ -173,11 +173,15 @@ std::optional<double> CollisionChecker::terrain_pitch(const map::MapView& view, 
   const double window = half * 0.84 + robot_.step_height_m;
   const auto front = view.support_surface_near((p.foot_m + half * fwd).cast<float>(), window);
   const auto back = view.support_surface_near((p.foot_m - half * fwd).cast<float>(), window);
-  // An end without observed support (the LiDAR's blind ring around the robot) stands at the
-  // foot's height: the legs are on the ground the robot stands on.
   if (!front && !back) return std::nullopt;
+  // One end unseen (the LiDAR's blind ring around the robot): with the seen end higher than the
+  // foot (front legs on a tread, rear ones on the floor unseen under the body) the unseen end
+  // stands at the foot's height. With the seen end lower, the pose's own pitch stands: the foot
+  // may lie above ground never seen (the top of a flight climbed blind, the foot on the line
+  // over the nosings), and the foot's height there pitched the body nose down into the landing.
   const double zf = front ? double(front->height_m) : p.foot_m.z();
   const double zb = back ? double(back->height_m) : p.foot_m.z();
+  if (std::max(zf, zb) <= p.foot_m.z() && (!front || !back)) return std::nullopt;
   if (mid_z) *mid_z = 0.5 * (zf + zb);
   return std::atan2(zf - zb, 2.0 * half);
 }

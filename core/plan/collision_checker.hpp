@@ -77,7 +77,8 @@ class CollisionChecker {
   CollisionHit check_poses(const map::MapView& view, std::span<const BodyPose> poses);
   // Terrain pitch under a pose: support heights half a body length ahead and behind (nearest
   // to the foot height within the slope window; an end without support is taken at the foot's
-  // height); nullopt if neither end has support.
+  // height if the other end is higher); nullopt if neither end has support, or one has and lies
+  // no higher than the foot.
   // `mid_z`: their mean, the height the body's bottom centre rests at on that slope.
   std::optional<double> terrain_pitch(const map::MapView& view, const BodyPose& p,
                                       double* mid_z = nullptr) const;

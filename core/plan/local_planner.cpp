@@ -489,6 +489,17 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   uint32_t robot_node = g.root();
   if (robot_node == graph::kNoId || !g.node(robot_node).alive)
     robot_node = g.nearest(in.robot_foot_m.cast<float>(), 1.5f, 1.0f);
+  // A robot's node without edges yet (new under the robot a step above the node it came from,
+  // GraphOptions::root_off_graph): search from the nearest linked node while one is near.
+  if (robot_node != graph::kNoId && g.node(robot_node).degree == 0) {
+    near_scratch_.clear();
+    g.nodes_within(in.robot_foot_m.cast<float>(), 1.5f, 1.0f, near_scratch_);
+    float best = std::numeric_limits<float>::infinity();
+    for (graph::NodeId n : near_scratch_) {
+      const float d = (g.node(n).p_m - in.robot_foot_m.cast<float>()).squaredNorm();
+      if (g.node(n).alive && g.node(n).degree > 0 && d < best) best = d, robot_node = n;
+    }
+  }
   if (robot_node == graph::kNoId) {
     out.status = LocalPlanStatus::kNoRobotNode;
     return out;

@@ -375,3 +375,31 @@ TEST(MapChangeDetector, ReportsWhereTheMapChangedAndWhatWasRemoved) {
   }
   EXPECT_TRUE(opened_there) << "the removal is not reported as an opening";
 }
+
+// GraphOptions::root_off_graph: a robot standing half a step or more above the nearest node and
+// away from it (a landing reached by a blind climb) gets a node of its own on the support under
+// its feet; without the option the nearest node is its node.
+TEST(ReachableGraph, RootOffGraphIsANewNodeUnderTheFeet) {
+  World w;
+  w.add({-4, -2, -0.3f}, {0, 2, 0.0f});  // floor
+  w.add({0, -2, -0.3f}, {3, 2, 0.15f});  // a platform 0.15 m up, not seen from the floor
+  for (bool off_graph : {false, true}) {
+    GraphOptions o;
+    o.root_radius_m = 2.0;
+    o.root_off_graph = off_graph;
+    Harness h(o);
+    h.observe(w, {-1.5f, 0, 0.5f}, {-1.5f, 0, 0}, 60000, 1, 1.2f);
+    ASSERT_NE(h.graph.root(), kNoId);
+    for (NodeId i = 0; i < h.graph.node_capacity(); ++i)
+      if (h.graph.node(i).alive) ASSERT_LT(h.graph.node(i).p_m.z(), 0.05f);
+    h.settle_cycles = 0;  // the root is attached before any expansion in the update
+    h.observe(w, {0.3f, 0, 0.65f}, {0.3f, 0, 0.15f}, 60000, 2, 3.0f);
+    ASSERT_NE(h.graph.root(), kNoId);
+    const Vector3f r = h.graph.node(h.graph.root()).p_m;
+    if (off_graph) {
+      EXPECT_NEAR(r.z(), 0.15f, 0.06f) << r.transpose();
+    } else {
+      EXPECT_LT(r.z(), 0.05f) << r.transpose();
+    }
+  }
+}

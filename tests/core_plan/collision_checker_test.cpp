@@ -92,6 +92,33 @@ TEST(CollisionChecker, StairsUnderTheFeetAreNotCollisions) {
   EXPECT_TRUE(cc.check_poses(poses, vox).collides);
 }
 
+TEST(CollisionChecker, TerrainPitchNeedsSupportUnderBothEnds) {
+  // A tread seen ahead of the body, nothing seen behind it (the top of a flight climbed blind:
+  // the robot's foot lies on the line over the nosings, above the last tread seen).
+  storey::test::World w;
+  w.add(storey::test::aabb({0.2f, -1, 2.5f}, {1.0f, 1, 2.66f}));
+  map::TraversabilityMap m;
+  storey::test::scan_world(m, w, {{2.5f, 0, 4.0f}});
+  CollisionChecker cc(RobotModel{}, m.view().voxel_size_m());
+  const BodyPose p{{0.25, 0, 2.81}, 0.0, 0.3};
+  ASSERT_TRUE(m.view().support_surface_near({0.6f, 0, 2.81f}, 0.5).has_value());  // front seen
+  // One end unseen, the seen one below the foot: no terrain pitch (the pose's own stands);
+  // taking the unseen end at the foot's height would pitch the body nose down (-12 deg).
+  EXPECT_FALSE(cc.terrain_pitch(m.view(), p).has_value());
+  // The seen end above the foot (front legs on a tread, rear ones on ground unseen): the
+  // unseen end at the foot's height.
+  const BodyPose low{{0.25, 0, 2.5}, 0.0, 0.0};
+  const auto up = cc.terrain_pitch(m.view(), low);
+  ASSERT_TRUE(up.has_value());
+  EXPECT_NEAR(*up, std::atan2(0.16, 0.7), 0.05);
+  // Seen under both ends: the slope between them.
+  w.add(storey::test::aabb({-0.8f, -1, 2.3f}, {0.0f, 1, 2.46f}));
+  storey::test::scan_world(m, w, {{-2.5f, 0, 4.0f}});
+  const auto tp = cc.terrain_pitch(m.view(), p);
+  ASSERT_TRUE(tp.has_value());
+  EXPECT_GT(*tp, 0.1);
+}
+
 TEST(CollisionChecker, NonFinitePoseIsReportedNotSafe) {
   CollisionChecker cc(RobotModel{}, 0.1);
   std::vector<Eigen::Vector3f> vox;
