@@ -34,13 +34,6 @@ AutonomyOptions widen_for_blind_zone(AutonomyOptions o) {
   return o;
 }
 
-// A blind climb ends on a landing the graph never reached: the robot's node is then a new one
-// there (GraphOptions::root_off_graph), not the flight's top node a step below.
-AutonomyOptions with_climb_roots(AutonomyOptions o) {
-  o.params.graph.root_off_graph = o.params.plan.climb_blind;
-  return o;
-}
-
 core::plan::BodyPose pose_on(const core::plan::BsplineTrajectory& t, double tau) {
   return t.pose(std::clamp(tau, t.t_start(), t.t_end()));
 }
@@ -49,7 +42,7 @@ core::plan::BodyPose pose_on(const core::plan::BsplineTrajectory& t, double tau)
 Autonomy::Autonomy(Platform& platform, const rt::Clock& clock, AutonomyOptions options)
     : platform_(platform),
       clock_(clock),
-      opt_(with_climb_roots(widen_for_blind_zone(std::move(options)))),
+      opt_(widen_for_blind_zone(std::move(options))),
       trace_(opt_.trace_events),
       pool_(opt_.scan_pool),
       filled_q_(opt_.scan_pool),

@@ -37,8 +37,9 @@ struct GraphOptions {
                                       // for at most this long (a sparsely observed gap)
   double surface_tolerance_m = 0.03;  // slack on the step height for surface noise
   double root_radius_m = 1.0;         // the robot's node: nearest within this, else a new one
-  // The robot's node where the nearest one lies more than half a step below or above it and
-  // farther than node_clearance_m: a new node on the support under the feet. A robot that
+  // Experimental (set by plan.climb_blind). The robot's node where the nearest one lies more
+  // than half a step below or above it and farther than node_clearance_m: a new node on the
+  // support under the feet. A robot that
   // climbed a flight blind (PlanOptions::climb_blind) stands on a landing G_real never reached,
   // and the flight's top node is no place to grow the new floor's graph from.
   bool root_off_graph = false;
