@@ -257,7 +257,8 @@ void read_root(SectionReader& r, Parameters& p) {
   read_graph(r.section("graph"), p.graph);
   read_plan(r.section("plan"), p.plan);
   // One switch for the experimental blind stair climb, read by the map and the graph as well.
-  p.map.pool_short_risers = p.graph.climb_frontiers = p.graph.root_off_graph = p.plan.climb_blind;
+  p.map.pool_short_risers = p.map.seed_under_feet = p.graph.climb_frontiers =
+      p.graph.root_off_graph = p.plan.climb_blind;
   read_sensor(r.section("sensor"), p.sensor);
   read_rates(r.section("rates"), p.rates);
   read_safety(r.section("safety"), p.safety);

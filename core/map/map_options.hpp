@@ -7,6 +7,9 @@ struct MapOptions {
   // Experimental (issue #9, set by plan.climb_blind): a riser's short top piece is judged with
   // the riser below it (riser_plane), and a sheet over observed open air is a ledge, not a step.
   bool pool_short_risers = false;
+  // Experimental (set by plan.climb_blind): the C_reach seed prefers the support under the body
+  // at the feet's level to C_reach members (a landing reached by a blind climb).
+  bool seed_under_feet = false;
   // --- occupancy (ray casting) ---
   double voxel_size_m = 0.1;    // map resolution
   double max_range_m = 30.0;    // rays beyond this are truncated (free space only, no endpoint)

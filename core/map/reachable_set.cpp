@@ -105,8 +105,13 @@ std::optional<VoxelKey> TraversabilityMap::find_seed(const Eigen::Vector3f& foot
         if (!c || c->state != TravState::kTraversable) continue;
         const double dh = surface_height(k, rstats(k)) - foot.z();
         if (std::abs(dh) > robot_.step_height_m) continue;
-        // Prefer members of C_reach (the robot stands on the component it came from).
-        const bool reach = c->flags & Cell::kReachable;
+        // Prefer members of C_reach (the robot stands on the component it came from), and with
+        // seed_under_feet the support under the body at the feet's level as well: after a blind
+        // climb the robot stands on a landing C_reach never reached, and the flight's treads
+        // within the search radius are a step lower.
+        const bool under = opt_.seed_under_feet && d2 * s * s <= 0.35 * 0.35 &&
+                           std::abs(dh) <= 0.5 * robot_.step_height_m;
+        const bool reach = (c->flags & Cell::kReachable) || under;
         const double d = d2 * s * s + dh * dh;
         if ((reach && !best_reach) || (reach == best_reach && d < best_d)) {
           best = k;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <map>
 
@@ -135,9 +136,7 @@ const graph::FrontierCluster* LocalPlanner::track_target(const LocalPlanInput& i
     remember_target(in, *c);
     return c;
   }
-  // Not with the blind climb (experimental): with the tracking the house's climb started from
-  // elsewhere and the look-ahead stopped it on the top nosing (seed 1; not yet fixed).
-  if (target_cluster_ < 0 || plan_opt_.climb_blind) return nullptr;
+  if (target_cluster_ < 0) return nullptr;
   const graph::FrontierCluster* best = nullptr;
   float best_d = float(opt_.track_radius_m);
   for (const auto& c : *in.clusters)
@@ -320,6 +319,25 @@ bool LocalPlanner::climb_on(const LocalPlanInput& in, LocalPlanResult& out, bool
   return straight_walk(in, pts, std::atan2(axis->dir.y(), axis->dir.x()), out);
 }
 
+bool LocalPlanner::on_climbed_flight(const Eigen::Vector3f& p) const {
+  for (const ClimbedFlight& f : climbed_) {
+    if (p.z() > f.top_z_m + 0.1f) continue;
+    for (const Eigen::Vector3f& q : f.path_m)
+      if ((q - p).head<2>().norm() < 0.8f) return true;
+  }
+  return false;
+}
+
+bool LocalPlanner::other_targets(const LocalPlanInput& in, int32_t except_id) const {
+  const graph::ReachableGraph& g = *in.graph;
+  for (const graph::FrontierCluster& c : *in.clusters) {
+    if (c.id == except_id) continue;
+    for (graph::NodeId n : c.nodes)
+      if (!ignored(g.node(n).p_m)) return true;
+  }
+  return false;
+}
+
 bool LocalPlanner::try_target(const LocalPlanInput& in, const Viewpoint& vp, LocalPlanResult& out,
                               SetAsideReason* why) {
   *why = SetAsideReason::kAstarFailed;
@@ -391,6 +409,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   auto commit = [&](const char* reason) {
     has_target_ = true;
     committed_ = plan_opt_.climb_blind;
+    climbing_ = std::strncmp(reason, "climb on", 8) == 0;
     target_cluster_ = -1;
     target_m_ = out.target_m;
     current_ = out.trajectory;
@@ -421,9 +440,29 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     if (committed_ && (in.t_s >= current_.t_end() || dxy <= 0.1)) {
       reason = in.t_s > current_.t_end() + 3.0 ? "escape or climb overdue" : "escape or climb done";
       has_target_ = committed_ = false;
-    } else if (!committed_ && reached && tc && try_climb(false)) {
-      return commit("climb on: a frontier on a flight is not seen from on it");
+
+    } else if (climb_start_ && reached) {
+      climb_start_ = false;
+      deferred_climb_.reset();
+      if (try_climb(false))
+        return commit("climb on: the floor is done, up the flight left for last");
+      reason = "back at a flight left for last: no climb from here";
+      has_target_ = false;
+    } else if (!committed_ && !climb_start_ && reached && tc && try_climb(false)) {
+      if (!other_targets(in, tc->id))
+        return commit("climb on: a frontier on a flight is not seen from on it");
+      // Other frontiers first: the climb is one way.
+      --climbs_;
+      const int expired = out.set_aside_expired;
+      out = LocalPlanResult{};
+      out.clusters_total = int(in.clusters->size());
+      out.set_aside_expired = expired;
+      deferred_climb_ = DeferredClimb{in.robot_foot_m, in.robot_yaw_rad};
+      set_aside_cluster(in, *tc, SetAsideReason::kStillFrontierAtTarget);
+      reason = "climb left for last: other frontiers on this floor first";
+      has_target_ = false;
     } else if (!committed_ && (reached || in.t_s > current_.t_end() + 3.0)) {
+      if (climb_start_) deferred_climb_.reset();  // overdue on the way back to it: given up
       // Stood at the viewpoint (or should have long ago) and the cluster is still there. First
       // walk onto the frontier itself (the LiDAR's blind ring moves with the robot, so the
       // ground beyond a frontier is often only seen from on top of it); if it still persists,
@@ -440,7 +479,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
       }
       reason = reached ? "target reached" : "target overdue";
       has_target_ = false;
-    } else if (!tc && !committed_) {
+    } else if (!tc && !committed_ && !climb_start_) {
       reason = "target cluster observed";
       has_target_ = false;
     } else {
@@ -477,11 +516,54 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     }
   }
   out.replan_reason = reason;
+  climb_start_ = false;
+  if (climbing_) {  // a climb ended (done, overdue, or dropped on a predicted collision)
+    climbing_ = false;
+    climb_done_s_ = in.t_s;
+    const float top = float(current_.pose(current_.t_end()).foot_m.z());
+    ClimbedFlight f{{}, top};
+    for (double t = current_.t_start(); t <= current_.t_end(); t += 0.25) {
+      const Eigen::Vector3f q = current_.pose(t).foot_m.cast<float>();
+      if (q.z() < top - 0.05f) f.path_m.push_back(q);  // the flight, not the landing
+    }
+    climbed_.push_back(std::move(f));
+  }
+  // No other target left on this floor: back to the flight left for last, or up it from there.
+  auto climb_last = [&]() {
+    if (!deferred_climb_ || !plan_opt_.climb_blind) return false;
+    const DeferredClimb d = *deferred_climb_;
+    if ((in.robot_foot_m - d.foot_m).head<2>().norm() <= opt_.reached_radius_m &&
+        std::abs(in.robot_foot_m.z() - d.foot_m.z()) < 0.5) {
+      deferred_climb_.reset();
+      return try_climb(false);
+    }
+    SetAsideReason why = SetAsideReason::kAstarFailed;
+    if (!free_start(in) ||
+        !try_target(in, Viewpoint{d.foot_m, d.yaw_rad, graph::kNoId}, out, &why)) {
+      deferred_climb_.reset();
+      return false;
+    }
+    climb_start_ = true;
+    return true;
+  };
+  auto to_climb = [&](const char* reason) {
+    if (!climb_start_) return commit(reason);
+    has_target_ = true;
+    committed_ = false;
+    target_cluster_ = -1;
+    target_m_ = out.target_m;
+    current_ = out.trajectory;
+    planned_at_s_ = in.t_s;
+    out.replan_reason = "back to the flight left for last: no other target on this floor";
+    out.status = LocalPlanStatus::kNewTrajectory;
+    return out;
+  };
 
   // ---- Stage 1: TSP over the cluster representatives (graph path costs).
   probe_mark(probe_, PlanStage::kLocalStage1);
   if (in.clusters->empty()) {
     if (try_climb(true)) return commit("climb on: no frontier, standing on a flight");
+    if (climb_last()) return to_climb("climb on: no frontier, up the flight left for last");
     out.status = LocalPlanStatus::kNoFrontiers;
     return out;
   }
@@ -490,7 +572,14 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   if (robot_node == graph::kNoId || !g.node(robot_node).alive)
     robot_node = g.nearest(in.robot_foot_m.cast<float>(), 1.5f, 1.0f);
   // A robot's node without edges yet (new under the robot a step above the node it came from,
-  // GraphOptions::root_off_graph): search from the nearest linked node while one is near.
+  // GraphOptions::root_off_graph). Just after a blind climb it is the new floor's first node:
+  // wait for the graph to grow from it (the nodes below are the flight's, not a way on). Else
+  // search from the nearest linked node while one is near.
+  const bool just_climbed = climb_done_s_ >= 0 && in.t_s - climb_done_s_ < opt_.climb_settle_s;
+  if (robot_node != graph::kNoId && g.node(robot_node).degree == 0 && just_climbed) {
+    out.status = LocalPlanStatus::kNoRobotNode;
+    return out;
+  }
   if (robot_node != graph::kNoId && g.node(robot_node).degree == 0) {
     near_scratch_.clear();
     g.nodes_within(in.robot_foot_m.cast<float>(), 1.5f, 1.0f, near_scratch_);
@@ -545,6 +634,8 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   }
   if (cands.empty()) {
     if (try_climb(true)) return commit("climb on: no reachable frontier, standing on a flight");
+    if (climb_last())
+      return to_climb("climb on: no reachable frontier, up the flight left for last");
     out.status = LocalPlanStatus::kNoReachableTarget;
     return out;
   }
@@ -665,8 +756,13 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   // Every attempt failed. If the robot cannot turn where it stands (a dead end narrower than
   // the body's turning circle: every path back starts with a turn), the clusters are not to
   // blame: step straight to the nearest pose where it can turn, and plan again from there.
-  if (!failed.empty() && try_climb(true))
-    return commit("climb on: no way to a frontier, standing on a flight");
+  if (!failed.empty() && try_climb(true)) {
+    if (!other_targets(in, -1))
+      return commit("climb on: no way to a frontier, standing on a flight");
+    --climbs_;  // one way: left for last (other frontiers may become reachable from elsewhere)
+    deferred_climb_ = DeferredClimb{in.robot_foot_m, in.robot_yaw_rad};
+    out.trajectory = BsplineTrajectory{};
+  }
   if (!failed.empty() && escape(in, out)) return commit("escape: cannot turn here");
   // Every attempt's body hit an obstacle next to the start: the start is boxed in (it faces a
   // wall, or stands by a wall end it cannot curve away from), not the clusters: step away from
@@ -696,6 +792,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
       failures_.erase(it);
     }
   }
+  if (climb_last()) return to_climb("climb on: no way to a frontier, up the flight left for last");
   out.status = LocalPlanStatus::kNoReachableTarget;
   return out;
 }

@@ -126,6 +126,7 @@ struct LocalPlannerOptions {
   int max_start_escapes = 3;             // ... at most this many escapes in a row
   double landing_step_m = 0.6;           // climb_on: past the last support seen on a flight
   int max_climbs = 3;                    // climb_on moves in a row without a new target
+  double climb_settle_s = 15.0;          // after a climb: wait this long for the landing's graph
   double set_aside_expiry_s = 30.0;      // a set-aside node may expire after this [s] ...
   double set_aside_expiry_move_m = 2.0;  // ... once the robot is this far from where it was
 };
@@ -153,7 +154,12 @@ class LocalPlanner {
     size_t cluster_index;
     uint32_t rep;  // representative node (nearest the centroid)
   };
-  bool ignored(const Eigen::Vector3f& p) const { return set_aside_at(p) != nullptr; }
+  bool ignored(const Eigen::Vector3f& p) const {
+    return set_aside_at(p) != nullptr || on_climbed_flight(p);
+  }
+  // Over a flight climbed blind (within 0.8 m of the climb's path below the landing), no
+  // higher than its landing.
+  bool on_climbed_flight(const Eigen::Vector3f& p) const;
   void set_aside_cluster(const LocalPlanInput& in, const graph::FrontierCluster& c,
                          SetAsideReason reason, const Eigen::Vector3f& hit_m = kNoHitM);
   int expire_set_aside(const LocalPlanInput& in);
@@ -170,6 +176,8 @@ class LocalPlanner {
               const Eigen::Vector3f* away_from = nullptr);
   bool try_target(const LocalPlanInput& in, const Viewpoint& vp, LocalPlanResult& out,
                   SetAsideReason* why);
+  // A cluster other than except_id with a frontier node not set aside.
+  bool other_targets(const LocalPlanInput& in, int32_t except_id) const;
   // Facing up a flight: straight up the flight's axis to the last support seen and
   // landing_step_m beyond (see local_planner.cpp). on_flight_only: only if the robot stands on
   // the flight already (a lower tread behind it).
@@ -213,6 +221,25 @@ class LocalPlanner {
   int start_escapes_ = 0;                 // escapes from a boxed-in start since the last target
   int climbs_ = 0;                        // climb_on moves since the last target
   bool committed_ = false;  // an escape or climb (PlanOptions::climb_blind): kept to its end
+  // A blind climb is one way (the flight it crosses blind is not in G_real to come back down):
+  // one found while other frontiers were left waits here (where the robot stood, facing the
+  // flight) until the floor has no other reachable target; climb_start_: walking back to it.
+  struct DeferredClimb {
+    Eigen::Vector3d foot_m;
+    double yaw_rad;
+  };
+  std::optional<DeferredClimb> deferred_climb_;
+  bool climb_start_ = false;
+  bool climbing_ = false;     // the committed move is a climb
+  double climb_done_s_ = -1;  // when the last climb ended
+  // Flights climbed blind: the climb's foot points and its landing height. Their frontiers stay
+  // (the treads are edge-on from on the flight) and nothing resolves them from below; once the
+  // landing's graph links to the flight's they would send the robot back down.
+  struct ClimbedFlight {
+    std::vector<Eigen::Vector3f> path_m;
+    float top_z_m;
+  };
+  std::vector<ClimbedFlight> climbed_;
   std::vector<int32_t>
       approached_;  // clusters whose viewpoint was reached once (walk onto them next)
 };

@@ -191,3 +191,32 @@ TEST(ReachableSet, StridesOverAnUnseenStripOnlyUpOrDownAStep) {
   EXPECT_FALSE(reaches_far_patch(0.02f, false)) << "a hole in level ground was bridged";
   EXPECT_FALSE(reaches_far_patch(0.17f, true)) << "strode through a wall";
 }
+
+// MapOptions::seed_under_feet (with plan.climb_blind): a robot standing on support C_reach never
+// reached (a landing after a blind climb), a step above a C_reach member within the seed radius,
+// seeds C_reach under its feet; without the option the seed stays on the component it came from.
+TEST(ReachableSet, SeedUnderTheFeetAfterAClimbOnlyWithTheOption) {
+  auto landing_reached = [](bool under_feet) {
+    MapOptions o;
+    o.seed_under_feet = under_feet;
+    TraversabilityMap m(o);
+    std::vector<Vector3f> pts;
+    for (float y = -0.5f; y <= 0.5f; y += 0.02f) {
+      for (float x = -1.5f; x < 0.49f; x += 0.02f) pts.emplace_back(x, y, 0.02f);  // flight top
+      for (float z = 0.05f; z < 0.8f; z += 0.02f) pts.emplace_back(0.55f, y, z);   // no way across
+      for (float x = 0.61f; x < 2.0f; x += 0.02f) pts.emplace_back(x, y, 0.17f);   // landing
+    }
+    for (int rep = 0; rep < 4; ++rep) m.insert_scan(Vector3f(0.5f, 0.0f, 1.5f), pts);
+    m.update_traversability();
+    m.update_reachable(Vector3f(-0.5f, 0.0f, 0.02f));
+    const MapView v = m.view();
+    const VoxelKey landing = v.key_of(Vector3f(1.2f, 0.05f, 0.16f));
+    EXPECT_EQ(v.state(landing), TravState::kTraversable);
+    EXPECT_FALSE(v.is_reachable(landing));
+    m.update_reachable(Vector3f(0.9f, 0.0f, 0.17f));  // the robot now stands on the landing
+    EXPECT_EQ(flagged_reachable(m), scratch_reachable(m));
+    return m.view().is_reachable(landing);
+  };
+  EXPECT_FALSE(landing_reached(false));
+  EXPECT_TRUE(landing_reached(true));
+}
