@@ -390,8 +390,11 @@ TEST(ReachableGraph, RootOffGraphIsANewNodeUnderTheFeet) {
     Harness h(o);
     h.observe(w, {-1.5f, 0, 0.5f}, {-1.5f, 0, 0}, 60000, 1, 1.2f);
     ASSERT_NE(h.graph.root(), kNoId);
-    for (NodeId i = 0; i < h.graph.node_capacity(); ++i)
-      if (h.graph.node(i).alive) ASSERT_LT(h.graph.node(i).p_m.z(), 0.05f);
+    for (NodeId i = 0; i < h.graph.node_capacity(); ++i) {
+      if (h.graph.node(i).alive) {
+        ASSERT_LT(h.graph.node(i).p_m.z(), 0.05f);
+      }
+    }
     h.settle_cycles = 0;  // the root is attached before any expansion in the update
     h.observe(w, {0.3f, 0, 0.65f}, {0.3f, 0, 0.15f}, 60000, 2, 3.0f);
     ASSERT_NE(h.graph.root(), kNoId);
