@@ -39,9 +39,9 @@ struct GraphOptions {
   double root_radius_m = 1.0;         // the robot's node: nearest within this, else a new one
   // Experimental (set by plan.climb_blind). The robot's node where the nearest one lies more
   // than half a step below or above it and farther than node_clearance_m: a new node on the
-  // support under the feet. A robot that
-  // climbed a flight blind (PlanOptions::climb_blind) stands on a landing G_real never reached,
-  // and the flight's top node is no place to grow the new floor's graph from.
+  // support under the feet. A robot that climbed a flight blind (PlanOptions::climb_blind)
+  // stands on a landing G_real never reached, and the flight's top node is no place to grow the
+  // new floor's graph from.
   bool root_off_graph = false;
   double floor_height_hint_m = 3.0;  // floor id hint = round(z / this) (planning refines floors)
   // A cut that leaves the robot in the smaller part is more likely a transient (a node near the

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <limits>
 #include <map>
 
@@ -409,7 +408,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   auto commit = [&](const char* reason) {
     has_target_ = true;
     committed_ = plan_opt_.climb_blind;
-    climbing_ = std::strncmp(reason, "climb on", 8) == 0;
+    climbing_ = false;
     target_cluster_ = -1;
     target_m_ = out.target_m;
     current_ = out.trajectory;
@@ -417,6 +416,20 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     out.replan_reason = reason;
     out.status = LocalPlanStatus::kNewTrajectory;
     return out;
+  };
+  auto commit_climb = [&](const char* reason) {
+    commit(reason);
+    climbing_ = true;
+    return out;
+  };
+  // A climb found while other frontiers are left: kept for last (climb_on's walk dropped).
+  auto defer_climb = [&]() {
+    --climbs_;
+    deferred_climb_ = DeferredClimb{in.robot_foot_m, in.robot_yaw_rad};
+    out.trajectory = BsplineTrajectory{};
+    out.path_m.clear();
+    out.target_m = Eigen::Vector3d::Zero();
+    out.target_yaw_rad = out.real_until_s = 0;
   };
   // The blind climb (PlanOptions::climb_blind), at most max_climbs times without a new target.
   auto try_climb = [&](bool on_flight_only) {
@@ -440,24 +453,17 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     if (committed_ && (in.t_s >= current_.t_end() || dxy <= 0.1)) {
       reason = in.t_s > current_.t_end() + 3.0 ? "escape or climb overdue" : "escape or climb done";
       has_target_ = committed_ = false;
-
     } else if (climb_start_ && reached) {
       climb_start_ = false;
       deferred_climb_.reset();
       if (try_climb(false))
-        return commit("climb on: the floor is done, up the flight left for last");
+        return commit_climb("climb on: the floor is done, up the flight left for last");
       reason = "back at a flight left for last: no climb from here";
       has_target_ = false;
     } else if (!committed_ && !climb_start_ && reached && tc && try_climb(false)) {
       if (!other_targets(in, tc->id))
-        return commit("climb on: a frontier on a flight is not seen from on it");
-      // Other frontiers first: the climb is one way.
-      --climbs_;
-      const int expired = out.set_aside_expired;
-      out = LocalPlanResult{};
-      out.clusters_total = int(in.clusters->size());
-      out.set_aside_expired = expired;
-      deferred_climb_ = DeferredClimb{in.robot_foot_m, in.robot_yaw_rad};
+        return commit_climb("climb on: a frontier on a flight is not seen from on it");
+      defer_climb();  // other frontiers first: the climb is one way
       set_aside_cluster(in, *tc, SetAsideReason::kStillFrontierAtTarget);
       reason = "climb left for last: other frontiers on this floor first";
       has_target_ = false;
@@ -547,7 +553,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     return true;
   };
   auto to_climb = [&](const char* reason) {
-    if (!climb_start_) return commit(reason);
+    if (!climb_start_) return commit_climb(reason);
     has_target_ = true;
     committed_ = false;
     target_cluster_ = -1;
@@ -562,7 +568,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   // ---- Stage 1: TSP over the cluster representatives (graph path costs).
   probe_mark(probe_, PlanStage::kLocalStage1);
   if (in.clusters->empty()) {
-    if (try_climb(true)) return commit("climb on: no frontier, standing on a flight");
+    if (try_climb(true)) return commit_climb("climb on: no frontier, standing on a flight");
     if (climb_last()) return to_climb("climb on: no frontier, up the flight left for last");
     out.status = LocalPlanStatus::kNoFrontiers;
     return out;
@@ -575,12 +581,11 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   // GraphOptions::root_off_graph). Just after a blind climb it is the new floor's first node:
   // wait for the graph to grow from it (the nodes below are the flight's, not a way on). Else
   // search from the nearest linked node while one is near.
-  const bool just_climbed = climb_done_s_ >= 0 && in.t_s - climb_done_s_ < opt_.climb_settle_s;
-  if (robot_node != graph::kNoId && g.node(robot_node).degree == 0 && just_climbed) {
-    out.status = LocalPlanStatus::kNoRobotNode;
-    return out;
-  }
   if (robot_node != graph::kNoId && g.node(robot_node).degree == 0) {
+    if (climb_done_s_ >= 0 && in.t_s - climb_done_s_ < opt_.climb_settle_s) {
+      out.status = LocalPlanStatus::kNoRobotNode;
+      return out;
+    }
     near_scratch_.clear();
     g.nodes_within(in.robot_foot_m.cast<float>(), 1.5f, 1.0f, near_scratch_);
     float best = std::numeric_limits<float>::infinity();
@@ -633,7 +638,8 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     cand_dist.push_back(d);
   }
   if (cands.empty()) {
-    if (try_climb(true)) return commit("climb on: no reachable frontier, standing on a flight");
+    if (try_climb(true))
+      return commit_climb("climb on: no reachable frontier, standing on a flight");
     if (climb_last())
       return to_climb("climb on: no reachable frontier, up the flight left for last");
     out.status = LocalPlanStatus::kNoReachableTarget;
@@ -758,10 +764,8 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   // blame: step straight to the nearest pose where it can turn, and plan again from there.
   if (!failed.empty() && try_climb(true)) {
     if (!other_targets(in, -1))
-      return commit("climb on: no way to a frontier, standing on a flight");
-    --climbs_;  // one way: left for last (other frontiers may become reachable from elsewhere)
-    deferred_climb_ = DeferredClimb{in.robot_foot_m, in.robot_yaw_rad};
-    out.trajectory = BsplineTrajectory{};
+      return commit_climb("climb on: no way to a frontier, standing on a flight");
+    defer_climb();  // other frontiers may become reachable from elsewhere
   }
   if (!failed.empty() && escape(in, out)) return commit("escape: cannot turn here");
   // Every attempt's body hit an obstacle next to the start: the start is boxed in (it faces a
