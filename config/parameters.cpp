@@ -82,6 +82,7 @@ void read_map(SectionReader&& r, core::map::MapOptions& o) {
   r.get("log_odds_max", o.log_odds_max, Range{0.0, 20.0});
   r.get("log_odds_occupied", o.log_odds_occupied, Range{-10.0, 10.0});
   r.get("n_min", o.n_min, Range{1, 1000});
+  r.get("spill_is_surface", o.spill_is_surface);
   r.get("neighbourhood_radius_m", o.neighbourhood_radius_m, Range{0.01, 5.0});
   r.get("neighbourhood_dz_m", o.neighbourhood_dz_m, Range{0.0, 2.0});
   r.get("n_ref", o.n_ref, Range{1, 100000});
@@ -114,6 +115,7 @@ void read_graph(SectionReader&& r, core::graph::GraphOptions& o) {
   r.get("use_c_sur", o.use_c_sur);
   r.get("use_c_exp", o.use_c_exp);
   r.get("boundary_frontiers", o.boundary_frontiers);
+  r.get("close_probes_at_holes", o.close_probes_at_holes);
   r.get("neighbour_radius_factor", o.neighbour_radius_factor, Range{1.0, 5.0});
   r.get_deg("max_edge_slope_deg", o.max_edge_slope_rad, Range{0.0, 75.0});
   r.get("max_gap_m", o.max_gap_m, Range{0.0, 5.0});
@@ -166,6 +168,7 @@ void read_plan(SectionReader&& r, core::plan::PlanOptions& o) {
   r.get("zone_visit_radius_m", o.zone_visit_radius_m, Range{0.1, 50.0});
   r.get("use_prior", o.use_prior);
   r.get("climb_blind", o.climb_blind);
+  r.get("target_momentum", o.target_momentum);
   r.get("incremental_maintenance", o.incremental_maintenance);
 }
 

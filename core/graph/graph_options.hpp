@@ -19,6 +19,9 @@ struct GraphOptions {
   // Experimental (issue #9, set by plan.climb_blind): one open probe that climbed a stair step
   // satisfies C_exp (a flight is one probe wide), and a probe follows a flight to its top.
   bool climb_frontiers = false;
+  // Experimental (issue #9, graph.close_probes_at_holes): a C_exp probe entering unknown space
+  // through a voxel-sized gap in a surface (a wall seen at grazing angles) is closed.
+  bool close_probes_at_holes = false;
   double probe_length_m = 3.0;      // probe length for C_exp
   int cluster_capacity = 8;         // maximum frontier nodes per cluster
   int viewpoints_per_cluster = 8;   // K, best viewpoints kept per cluster

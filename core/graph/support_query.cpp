@@ -167,14 +167,27 @@ map::Occupancy SupportQuery::walk(const Eigen::Vector3f& from, const Eigen::Vect
   return result;
 }
 
+bool SupportQuery::hole_in_surface(const VoxelKey& k) {
+  auto occ = [&](int32_t dx, int32_t dy, int32_t dz) {
+    return occupancy({k.x + dx, k.y + dy, k.z + dz}) == Occupancy::kOccupied;
+  };
+  // Surface on both sides along one axis: a gap in a sheet. One side only is an edge (the top
+  // of a riser with the tread beyond it unseen: a stair's frontier, kept open).
+  return (occ(1, 0, 0) && occ(-1, 0, 0)) || (occ(0, 1, 0) && occ(0, -1, 0)) ||
+         (occ(0, 0, 1) && occ(0, 0, -1));
+}
+
 SupportQuery::ProbeSegment SupportQuery::probe_segment(const Eigen::Vector3f& from,
                                                        const Eigen::Vector3f& to, int need_free,
                                                        int* free_total, int* unknown_run) {
   const VoxelKey start{int32_t(std::floor(from.x() * inv_vs_)),
                        int32_t(std::floor(from.y() * inv_vs_)), zkey(from.z())};
   ProbeSegment r;
+  VoxelKey prev = start;
   auto visit = [&](const VoxelKey& k) {
     if (k == start) return true;
+    const VoxelKey before = prev;
+    prev = k;
     switch (occupancy(k)) {
       case Occupancy::kOccupied:
         r.hit = true;
@@ -186,6 +199,15 @@ SupportQuery::ProbeSegment SupportQuery::probe_segment(const Eigen::Vector3f& fr
         return true;
       case Occupancy::kUnknown:
         if (*free_total < need_free) {  // did not start in known free space
+          r.closed = true;
+          return false;
+        }
+        // Entering unknown space through a gap in a surface (a wall seen only at grazing
+        // angles keeps voxel-sized holes, unknown or carved free; behind them lies the wall's or
+        // a ramp's solid, never observable): closed, else a corridor's walls made frontiers
+        // that no view resolves.
+        if (*unknown_run == 0 && opt_.close_probes_at_holes &&
+            (hole_in_surface(k) || hole_in_surface(before))) {
           r.closed = true;
           return false;
         }

@@ -118,6 +118,8 @@ class SupportQuery {
   };
   ProbeSegment probe_segment(const Eigen::Vector3f& from, const Eigen::Vector3f& to, int need_free,
                              int* free_total, int* unknown_run);
+  // Unknown voxel k between two occupied voxels on one axis: a gap in a surface.
+  bool hole_in_surface(const map::VoxelKey& k);
 
   const map::Cell* cell(const map::VoxelKey& k) { return reader_.cell(k); }
   bool occupied(const map::Cell* c) const {

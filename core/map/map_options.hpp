@@ -10,6 +10,9 @@ struct MapOptions {
   // Experimental (set by plan.climb_blind): the C_reach seed prefers the support under the body
   // at the feet's level to C_reach members (a landing reached by a blind climb).
   bool seed_under_feet = false;
+  // Experimental (issue #9, map.spill_is_surface): a voxel under N_min low over a level,
+  // well-observed floor is that floor's spill across a voxel boundary, judged as a surface.
+  bool spill_is_surface = false;
   // --- occupancy (ray casting) ---
   double voxel_size_m = 0.1;    // map resolution
   double max_range_m = 30.0;    // rays beyond this are truncated (free space only, no endpoint)

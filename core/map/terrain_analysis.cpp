@@ -133,10 +133,31 @@ bool TraversabilityMap::step_edge(const VoxelKey& k, const VoxelStats& s) {
   return true;
 }
 
+// A floor on a voxel boundary (z = 0 in the simulator; anywhere in a building) spills a few
+// noisy points into the voxel above its own. Under N_min that spill read S_unobs, sat on top of
+// the well-observed voxel (no top surface then), grazing rays carved it (a voxel of < 3 points
+// takes every miss) and the next scan's noise put it back: frontiers that came and went in
+// explored corridors (test_ramp's). A spill low in its voxel over
+// a level, well-observed sheet that reaches the top of its own voxel is that surface: judged
+// with its neighbourhood (Eq. 1 pools the columns around it) like any top voxel.
+bool TraversabilityMap::surface_spill(const VoxelKey& k, const VoxelStats& s) {
+  const float vs = float(opt_.voxel_size_m);
+  if (!opt_.spill_is_surface || s.count == 0 || s.mean[2] > -0.25f * vs) return false;
+  const VoxelKey kb{k.x, k.y, k.z - 1};
+  const Cell* b = rcell(kb);
+  if (!occupied(b) || b->stats == Cell::kNoStats) return false;
+  const VoxelStats* sb = reader_.stats(kb);
+  if (sb->count < uint32_t(opt_.n_min) || (sb->shape & VoxelStats::kStepEdge) ||
+      sb->mean[2] < 0.25f * vs)
+    return false;
+  const PointPlane p = point_plane(*sb);
+  return clear_plane(p) && std::abs(p.normal.z()) >= std::cos(robot_.max_slope_rad);
+}
+
 TravState TraversabilityMap::evaluate(const VoxelKey& k, VoxelStats* s) {
   const Cell* c = rcell(k);
   if (!occupied(c)) return TravState::kNone;
-  if (!s || s->count < uint32_t(opt_.n_min)) {  // Eq. 3, first case
+  if (!s || (s->count < uint32_t(opt_.n_min) && !surface_spill(k, *s))) {  // Eq. 3, first case
     if (s) s->count_eval = s->count;
     return TravState::kUnobserved;
   }

@@ -145,9 +145,10 @@ class TraversabilityMap {
     return std::min(h + sd, float((k.z + 1) * opt_.voxel_size_m));
   }
   void mark_changed(const VoxelKey& k, Cell& c);
-  TravState evaluate(const VoxelKey& k, VoxelStats* s);    // Eq. 1-3 for one voxel
-  bool step_edge(const VoxelKey& k, const VoxelStats& s);  // VoxelStats::kStepEdge test
-  bool connected(const VoxelKey& a, const VoxelKey& b);    // C_reach adjacency
+  TravState evaluate(const VoxelKey& k, VoxelStats* s);        // Eq. 1-3 for one voxel
+  bool step_edge(const VoxelKey& k, const VoxelStats& s);      // VoxelStats::kStepEdge test
+  bool surface_spill(const VoxelKey& k, const VoxelStats& s);  // under N_min, still a floor
+  bool connected(const VoxelKey& a, const VoxelKey& b);        // C_reach adjacency
   bool has_parent(const VoxelKey& k, uint32_t dist);
   void set_reachable(const VoxelKey& k, uint32_t dist);
   void clear_reachable(const VoxelKey& k);

@@ -44,6 +44,29 @@ const char* to_string(SetAsideReason r) {
   return "unknown";
 }
 
+// Target momentum: the tour re-solved at a periodic replan from a few metres further on often
+// starts at another cluster of nearly the same total cost (the two ways round a loop, two ends
+// of a corridor). Turning to it and back again at the next replan wastes both (test_ramp: the
+// robot turned back and forth at the loop's east end). The current target `kept` (index into the
+// TSP's clusters, matrix index kept + 1) stays first unless the new tour is shorter by the margin.
+void keep_first_in_tour(size_t kept, const std::vector<double>& cost, int n, bool with_anchor,
+                        double margin_m, double margin_frac, std::vector<size_t>& order) {
+  if (order.empty() || order.front() == kept) return;
+  auto tour_cost = [&](const std::vector<size_t>& o) {
+    double c = 0;
+    size_t at = 0;
+    for (size_t k : o) c += cost[at * size_t(n) + k + 1], at = k + 1;
+    if (with_anchor) c += cost[at * size_t(n) + size_t(n - 1)];
+    return c;
+  };
+  std::vector<size_t> alt{kept};
+  for (size_t k : order)
+    if (k != kept) alt.push_back(k);
+  if (alt.size() != order.size()) return;  // kept is not in the tour
+  const double c_new = tour_cost(order);
+  if (tour_cost(alt) <= c_new + std::max(margin_m, margin_frac * c_new)) order = std::move(alt);
+}
+
 LocalPlanner::LocalPlanner(const RobotModel& robot, const PlanOptions& plan, double voxel_size_m,
                            const LocalPlannerOptions& options)
     : robot_(robot),
@@ -443,6 +466,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   // ---- Keep the current target unless there is a reason to replan.
   probe_mark(probe_, PlanStage::kLocalKeep);
   const char* reason = "no target";
+  int32_t kept_cluster = -1;  // the target's cluster at a periodic replan (target momentum)
   if (has_target_) {
     const graph::FrontierCluster* tc = track_target(in);
     const double dxy = (in.robot_foot_m - target_m_).head<2>().norm();
@@ -512,6 +536,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
       } else if (!committed_ && in.t_s - planned_at_s_ >= opt_.replan_period_s) {
         reason = "periodic replan";
         has_target_ = false;
+        kept_cluster = tc ? tc->id : -1;
       } else {
         out.status = LocalPlanStatus::kKeep;
         out.target_cluster = target_cluster_;
@@ -675,6 +700,10 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   } else {
     for (size_t i = 0; i < sel.size(); ++i) order.push_back(i);  // by distance
   }
+  for (size_t i = 0; i < sel.size(); ++i)
+    if (plan_opt_.target_momentum && sel[i].cluster_id == kept_cluster)
+      keep_first_in_tour(i, cost, n, anchor_node != graph::kNoId, opt_.keep_target_margin_m,
+                         opt_.keep_target_margin_frac, order);
   for (size_t k : order) out.cluster_order.push_back(sel[k].cluster_id);
 
   // ---- Stage 2: one viewpoint per cluster over the window W (Eq. 6).

@@ -127,9 +127,17 @@ struct LocalPlannerOptions {
   double landing_step_m = 0.6;           // climb_on: past the last support seen on a flight
   int max_climbs = 3;                    // climb_on moves in a row without a new target
   double climb_settle_s = 15.0;          // after a climb: wait this long for the landing's graph
+  double keep_target_margin_m = 2.0;     // periodic replan: the current target stays first
+  double keep_target_margin_frac = 0.1;  // unless another tour is shorter by max(m, frac * tour)
   double set_aside_expiry_s = 30.0;      // a set-aside node may expire after this [s] ...
   double set_aside_expiry_move_m = 2.0;  // ... once the robot is this far from where it was
 };
+
+// Target momentum (periodic replans): `order` (indices into a tour's clusters; cost matrix
+// index + 1, robot at 0, an end anchor at n - 1 if with_anchor) is changed to start at `kept`
+// unless the tour as solved is shorter than that by max(margin_m, margin_frac * its cost).
+void keep_first_in_tour(size_t kept, const std::vector<double>& cost, int n, bool with_anchor,
+                        double margin_m, double margin_frac, std::vector<size_t>& order);
 
 class LocalPlanner {
  public:

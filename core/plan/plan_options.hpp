@@ -48,6 +48,9 @@ struct PlanOptions {
   // the landing, blind past the last support seen, and drive escapes to their end. Off by
   // default: the two-floor house is explored with it, test_ramp's ramp is not (docs/RESULTS.md).
   bool climb_blind = false;
+  // Experimental (issue #9): at a periodic replan the current target stays first unless another
+  // tour is clearly shorter (LocalPlannerOptions::keep_target_margin_m / _frac).
+  bool target_momentum = false;
   bool incremental_maintenance = true;
 };
 

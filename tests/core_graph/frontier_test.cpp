@@ -312,3 +312,38 @@ TEST(TopologicalFrontiers, ProbeClimbsAStairFlightToItsUnknownTreads) {
   // Toward the observed wall behind: closed either way.
   EXPECT_FALSE(q.probe_open_climbing(foot, back, 3.0f, 0.3f, min_free, 0.3f));
 }
+
+// A wall seen only at grazing angles keeps voxel-sized holes; behind them lies the wall's solid,
+// never observable. A C_exp probe entering unknown space through such a hole is closed (in
+// test_ramp's corridors these holes made frontiers no view could resolve); one through the
+// open end of a room stays open. Experimental, off by default (GraphOptions::
+// close_probes_at_holes).
+TEST(TopologicalFrontiers, ProbeThroughAHoleInAWallIsClosed) {
+  // Seen from origins up to the wall so the space in front of it is observed free; from the
+  // oblique ones a ray to a point beside the hole may cross the hole's voxel (carved free).
+  storey::core::map::TraversabilityMap m;
+  std::vector<Vector3f> pts;
+  for (float x = -1.95f; x < 2.0f; x += 0.1f)  // floor, up to the wall
+    for (float y = -1.95f; y < 2.0f; y += 0.1f) pts.push_back({x, y, -0.05f});
+  for (float y = -1.95f; y < 2.0f; y += 0.1f)  // wall face at x = 2.05 (solid behind it)
+    for (float z = 0.05f; z < 1.5f; z += 0.1f) {
+      const bool hole = std::abs(y - 0.05f) < 0.01f && std::abs(z - 0.35f) < 0.01f;
+      if (!hole) pts.push_back({2.05f, y, z});
+    }
+  for (const float ox : {0.0f, 1.0f, 1.7f})
+    for (const float oy : {-0.5f, 0.0f, 0.5f}) {
+      m.insert_scan(Vector3f(ox, oy, 0.55f), pts);
+      m.update_traversability();
+    }
+  for (const bool on : {true, false}) {
+    SCOPED_TRACE(on ? "graph.close_probes_at_holes on" : "off");
+    GraphOptions opt;
+    opt.close_probes_at_holes = on;
+    SupportQuery q(m.view(), opt);
+    const Vector3f foot(0.05f, 0.05f, 0.0f);
+    // Straight into the hole at the probe's height (0.3 m over the floor: voxel 0.3-0.4).
+    EXPECT_EQ(q.probe_open_climbing(foot, Eigen::Vector2f(1, 0), 3.0f, 0.3f, 0.2f, 0.3f), !on);
+    // Toward the room's unobserved side (no wall there): open either way.
+    EXPECT_TRUE(q.probe_open_climbing(foot, Eigen::Vector2f(0, 1), 3.0f, 0.3f, 0.2f, 0.3f));
+  }
+}

@@ -191,3 +191,38 @@ TEST(LocalPlanner, TargetIsKeptWhenItsClusterOnlyChangedItsId) {
   EXPECT_STREQ(r2.replan_reason, "target cluster observed");
   EXPECT_NE(r2.target_cluster, 100000);
 }
+
+// Target momentum (keep_first_in_tour): at a periodic replan the tour re-solved from a little
+// further on may start at another cluster for a metre or two less; the current target stays
+// first unless the other tour is shorter by max(margin_m, margin_frac * tour).
+TEST(LocalPlanner, PeriodicReplanKeepsTheTargetUnlessAnotherTourIsClearlyShorter) {
+  // The robot (0) between two corridor ends A (1) and B (2), 16 m apart.
+  auto costs = [](double to_a, double to_b) {
+    return std::vector<double>{0, to_a, to_b, to_a, 0, 16, to_b, 16, 0};
+  };
+  // B first is 1 m shorter (23 vs 24): A, the current target, stays first.
+  std::vector<size_t> order{1, 0};  // indices into the tour's clusters: B then A
+  keep_first_in_tour(0, costs(8, 7), 3, false, 2.0, 0.1, order);
+  EXPECT_EQ(order, (std::vector<size_t>{0, 1}));
+  // B first is 10 m shorter (19 vs 29): B stays first.
+  order = {1, 0};
+  keep_first_in_tour(0, costs(13, 3), 3, false, 2.0, 0.1, order);
+  EXPECT_EQ(order, (std::vector<size_t>{1, 0}));
+  // The fraction widens the margin on long tours: 3 m on a 40 m tour is kept (10 % = 4 m).
+  order = {1, 0};
+  keep_first_in_tour(0, costs(27, 24), 3, false, 2.0, 0.1, order);
+  EXPECT_EQ(order, (std::vector<size_t>{0, 1}));
+  // With an end anchor (a zone prior, matrix index n - 1) its leg counts: A first ends 20 m
+  // from the anchor instead of 1 m, 20 m longer: B stays first.
+  std::vector<double> c4{0, 8, 7, 30, 8, 0, 16, 1, 7, 16, 0, 20, 30, 1, 20, 0};
+  order = {1, 0};
+  keep_first_in_tour(0, c4, 4, true, 2.0, 0.1, order);
+  EXPECT_EQ(order, (std::vector<size_t>{1, 0}));
+  // Already first, or not in the tour: unchanged.
+  order = {0, 1};
+  keep_first_in_tour(0, costs(30, 1), 3, false, 2.0, 0.1, order);
+  EXPECT_EQ(order, (std::vector<size_t>{0, 1}));
+  order = {1};
+  keep_first_in_tour(0, costs(1, 30), 3, false, 2.0, 0.1, order);
+  EXPECT_EQ(order, (std::vector<size_t>{1}));
+}
