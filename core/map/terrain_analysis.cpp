@@ -137,9 +137,9 @@ bool TraversabilityMap::step_edge(const VoxelKey& k, const VoxelStats& s) {
 // noisy points into the voxel above its own. Under N_min that spill read S_unobs, sat on top of
 // the well-observed voxel (no top surface then), grazing rays carved it (a voxel of < 3 points
 // takes every miss) and the next scan's noise put it back: frontiers that came and went in
-// explored corridors (test_ramp's). A spill low in its voxel over
-// a level, well-observed sheet that reaches the top of its own voxel is that surface: judged
-// with its neighbourhood (Eq. 1 pools the columns around it) like any top voxel.
+// explored corridors (test_ramp's). A spill low in its voxel over a level, well-observed sheet
+// that reaches the top of its own voxel is that surface: judged with its neighbourhood (Eq. 1
+// pools the columns around it) like any top voxel.
 bool TraversabilityMap::surface_spill(const VoxelKey& k, const VoxelStats& s) {
   const float vs = float(opt_.voxel_size_m);
   if (!opt_.spill_is_surface || s.count == 0 || s.mean[2] > -0.25f * vs) return false;

@@ -700,10 +700,11 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   } else {
     for (size_t i = 0; i < sel.size(); ++i) order.push_back(i);  // by distance
   }
-  for (size_t i = 0; i < sel.size(); ++i)
-    if (plan_opt_.target_momentum && sel[i].cluster_id == kept_cluster)
-      keep_first_in_tour(i, cost, n, anchor_node != graph::kNoId, opt_.keep_target_margin_m,
-                         opt_.keep_target_margin_frac, order);
+  if (plan_opt_.target_momentum && kept_cluster >= 0)
+    for (size_t i = 0; i < sel.size(); ++i)
+      if (sel[i].cluster_id == kept_cluster)
+        keep_first_in_tour(i, cost, n, anchor_node != graph::kNoId, opt_.keep_target_margin_m,
+                           opt_.keep_target_margin_frac, order);
   for (size_t k : order) out.cluster_order.push_back(sel[k].cluster_id);
 
   // ---- Stage 2: one viewpoint per cluster over the window W (Eq. 6).

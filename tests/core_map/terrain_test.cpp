@@ -328,9 +328,9 @@ TEST(Terrain, FloorOnAVoxelBoundaryIsNotUnderObservedWhereItSpills) {
     SCOPED_TRACE(on ? "map.spill_is_surface on" : "off");
     World w;
     w.add(aabb({-6, -6, -0.3f}, {6, 6, 0.0f}));
-    MapOptions o;
-    o.spill_is_surface = on;
-    TraversabilityMap m(o);
+    MapOptions opt;
+    opt.spill_is_surface = on;
+    TraversabilityMap m(opt);
     uint32_t seed = 1;
     for (const Vector3f& o : ring_of_origins(0.55f))
       for (int i = 0; i < 2; ++i) {
