@@ -169,6 +169,7 @@ void read_plan(SectionReader&& r, core::plan::PlanOptions& o) {
   r.get("use_prior", o.use_prior);
   r.get("climb_blind", o.climb_blind);
   r.get("target_momentum", o.target_momentum);
+  r.get("path_retries", o.path_retries, Range{0, 10});
   r.get("incremental_maintenance", o.incremental_maintenance);
 }
 

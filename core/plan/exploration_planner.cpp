@@ -276,6 +276,7 @@ ExplorationResult ExplorationPlanner::plan_cycle(const ExplorationInput& in) {
     }
   }
   // 5) Local layer over every cluster (first floor, no prior, or guidance had nothing to do).
+  li.last_resort = true;
   LocalPlanResult lr = local_.plan(li);
   r.cluster_order = std::move(lr.cluster_order);
   switch (lr.status) {

@@ -93,9 +93,16 @@ uint16_t frontier_signature(const graph::GraphNode& n) {
 void LocalPlanner::set_aside_cluster(const LocalPlanInput& in, const graph::FrontierCluster& c,
                                      SetAsideReason reason, const Eigen::Vector3f& hit_m) {
   const graph::ReachableGraph& g = *in.graph;
-  for (graph::NodeId n : c.nodes)
-    set_aside_.push_back({g.node(n).p_m, in.t_s, c.id, reason, in.robot_foot_m.cast<float>(),
-                          frontier_signature(g.node(n)), hit_m});
+  const float r = float(opt_.track_radius_m);
+  for (graph::NodeId n : c.nodes) {
+    const Eigen::Vector3f p = g.node(n).p_m;
+    int retries = 0;  // a frontier retried here before keeps its count
+    for (const Retried& q : retried_)
+      if ((q.p_m - p).head<2>().norm() <= r && std::abs(q.p_m.z() - p.z()) < 0.5f)
+        retries = std::max(retries, q.retries);
+    set_aside_.push_back({p, in.t_s, c.id, reason, in.robot_foot_m.cast<float>(),
+                          frontier_signature(g.node(n)), hit_m, retries});
+  }
 }
 
 // A set-aside node means "not resolvable from where the robot can stand, on the map as it was
@@ -132,12 +139,79 @@ int LocalPlanner::expire_set_aside(const LocalPlanInput& in) {
     }
     expire = expire || (in.t_s - e.t_s >= opt_.set_aside_expiry_s &&
                         (robot - e.robot_m).head<2>().squaredNorm() > move2);
-    if (!expire) set_aside_[kept++] = e;
+    if (!expire)
+      set_aside_[kept++] = e;
+    else if (e.retries > 0)
+      retried_.push_back({e.p_m, e.retries});
   }
   const int n = int(set_aside_.size() - kept);
   set_aside_.resize(kept);
   expired_total_ += uint64_t(n);
   return n;
+}
+
+// Stage 3 failed for the last clusters from where the robot stands. That is often the robot's
+// fault, not the clusters': facing down a ramp too narrow to turn on, by a wall end it cannot
+// curve away from (test_ramp: the run ended "complete" with the upper floor unexplored). Before
+// the failures end the run, walk to a new vantage point, the nearest G_real node at least
+// retry_move_m away that a trajectory reaches, and release those set-asides when the walk ends.
+bool LocalPlanner::retry_from_elsewhere(const LocalPlanInput& in, LocalPlanResult& out) {
+  if (!in.last_resort || plan_opt_.path_retries <= 0 || robot_node_ >= sg_.num_nodes())
+    return false;
+  auto eligible = [&](const SetAsideEntry& e) {
+    return (e.reason == SetAsideReason::kAstarFailed ||
+            e.reason == SetAsideReason::kTrajectoryFailed) &&
+           e.retries < plan_opt_.path_retries && !e.retry_pending;
+  };
+  if (std::none_of(set_aside_.begin(), set_aside_.end(), eligible) || !free_start(in)) return false;
+  const graph::ReachableGraph& g = *in.graph;
+  const double r_min = opt_.retry_move_m, d_max = 3.0 * opt_.retry_move_m;
+  std::vector<std::pair<double, graph::NodeId>> cands;
+  for (const Settled& st :
+       search_.dijkstra(sg_, std::span<const uint32_t>(&robot_node_, 1), d_max)) {
+    const graph::GraphNode& gn = g.node(st.node);
+    if ((gn.p_m.cast<double>() - in.robot_foot_m).head<2>().norm() >= r_min)
+      cands.push_back({st.dist, st.node});
+  }
+  std::sort(cands.begin(), cands.end());
+  std::vector<Eigen::Vector3d> tried;  // one try per direction: a failed one's neighbours fail too
+  for (const auto& [d, n] : cands) {
+    if (int(tried.size()) >= opt_.max_retry_vantages) break;
+    const Eigen::Vector3d p = g.node(n).p_m.cast<double>();
+    if (std::any_of(tried.begin(), tried.end(),
+                    [&](const Eigen::Vector3d& q) { return (q - p).norm() < 1.0; }))
+      continue;
+    tried.push_back(p);
+    const Eigen::Vector2d dir = (p - in.robot_foot_m).head<2>();
+    SetAsideReason why;
+    if (!try_target(in, Viewpoint{p, std::atan2(dir.y(), dir.x()), n}, out, &why)) continue;
+    for (SetAsideEntry& e : set_aside_)
+      if (eligible(e)) ++e.retries, e.retry_pending = true;
+    retrying_ = has_target_ = committed_ = true;  // driven to its end, whatever it sees on the way
+    climbing_ = false;
+    target_cluster_ = -1;
+    target_m_ = out.target_m;
+    current_ = out.trajectory;
+    planned_at_s_ = in.t_s;
+    out.replan_reason = "retry: to a new vantage point for frontiers no path reached";
+    out.status = LocalPlanStatus::kNewTrajectory;
+    return true;
+  }
+  return false;
+}
+
+void LocalPlanner::release_retry() {
+  size_t kept = 0;
+  for (const SetAsideEntry& e : set_aside_) {
+    if (!e.retry_pending) {
+      set_aside_[kept++] = e;
+      continue;
+    }
+    retried_.push_back({e.p_m, e.retries});
+    ++expired_total_;
+  }
+  set_aside_.resize(kept);
+  retrying_ = false;
 }
 
 const graph::FrontierCluster* LocalPlanner::find_cluster(const LocalPlanInput& in,
@@ -548,6 +622,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   }
   out.replan_reason = reason;
   climb_start_ = false;
+  if (retrying_) release_retry();  // the retry move ended: plan from the new vantage point
   if (climbing_) {  // a climb ended (done, overdue, or dropped on a predicted collision)
     climbing_ = false;
     climb_done_s_ = in.t_s;
@@ -667,6 +742,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
       return commit_climb("climb on: no reachable frontier, standing on a flight");
     if (climb_last())
       return to_climb("climb on: no reachable frontier, up the flight left for last");
+    if (retry_from_elsewhere(in, out)) return out;
     out.status = LocalPlanStatus::kNoReachableTarget;
     return out;
   }
@@ -827,6 +903,12 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     }
   }
   if (climb_last()) return to_climb("climb on: no way to a frontier, up the flight left for last");
+  const bool left = std::any_of(cands.begin(), cands.end(), [&](const Candidate& c) {
+    const auto& nodes = (*in.clusters)[c.cluster_index].nodes;
+    return std::any_of(nodes.begin(), nodes.end(),
+                       [&](graph::NodeId n) { return !ignored(g.node(n).p_m); });
+  });
+  if (!left && retry_from_elsewhere(in, out)) return out;
   out.status = LocalPlanStatus::kNoReachableTarget;
   return out;
 }

@@ -51,6 +51,9 @@ struct LocalPlanInput {
   double robot_yaw_rad = 0;
   double t_s = 0;                           // now, on the trajectory's time base [s]
   std::optional<Eigen::Vector3d> anchor_m;  // c_anc from the macro layer (Stage 1 terminal)
+  // The last call of a cycle, over every cluster: with nothing else left, clusters set aside for
+  // a path failure may be retried from a new vantage point (PlanOptions::path_retries).
+  bool last_resort = false;
 };
 
 enum class LocalPlanStatus : uint8_t {
@@ -102,6 +105,8 @@ struct SetAsideEntry {
   uint16_t frontier_sig = 0;  // the node's frontier flags then (frontier_signature())
   // kTrajectoryFailed: a voxel the body hit on the last try (NaN otherwise): diagnostics.
   Eigen::Vector3f hit_m = kNoHitM;
+  int retries = 0;             // path-failure retries from a new vantage point so far (here)
+  bool retry_pending = false;  // released when the retry move ends
 };
 // C_sur, C_exp, boundary and |Theta_open| of a node packed: what TopologicalFrontiers
 // recomputes when the map near the node changes.
@@ -131,6 +136,9 @@ struct LocalPlannerOptions {
   double keep_target_margin_frac = 0.1;  // unless another tour is shorter by max(m, frac * tour)
   double set_aside_expiry_s = 30.0;      // a set-aside node may expire after this [s] ...
   double set_aside_expiry_move_m = 2.0;  // ... once the robot is this far from where it was
+  // Path-failure retry (PlanOptions::path_retries): a vantage point at least this far away.
+  double retry_move_m = 2.0;
+  int max_retry_vantages = 6;  // vantage points tried per cycle (bounded work)
 };
 
 // Target momentum (periodic replans): `order` (indices into a tour's clusters; cost matrix
@@ -171,6 +179,9 @@ class LocalPlanner {
   void set_aside_cluster(const LocalPlanInput& in, const graph::FrontierCluster& c,
                          SetAsideReason reason, const Eigen::Vector3f& hit_m = kNoHitM);
   int expire_set_aside(const LocalPlanInput& in);
+  // Nothing else left: move to a new vantage point before the path failures end the run.
+  bool retry_from_elsewhere(const LocalPlanInput& in, LocalPlanResult& out);
+  void release_retry();
   const graph::FrontierCluster* find_cluster(const LocalPlanInput& in, int32_t id) const;
   // The target cluster, under a new id if its nodes changed (see track_radius_m).
   const graph::FrontierCluster* track_target(const LocalPlanInput& in);
@@ -224,6 +235,14 @@ class LocalPlanner {
   std::vector<SetAsideEntry> set_aside_;
   uint64_t expired_total_ = 0;
   std::vector<graph::NodeId> near_scratch_;
+  // Path-failure set-asides released for a retry, with their count (a node set aside again near
+  // one inherits it, so the retries stay bounded); retrying_: a retry move is under way.
+  struct Retried {
+    Eigen::Vector3f p_m;
+    int retries;
+  };
+  std::vector<Retried> retried_;
+  bool retrying_ = false;
   std::vector<std::pair<int32_t, int>> failures_;
   Eigen::Vector3f last_hit_m_ = kNoHitM;  // try_target: where the last B-spline collided
   int start_escapes_ = 0;                 // escapes from a boxed-in start since the last target

@@ -51,6 +51,10 @@ struct PlanOptions {
   // Experimental (issue #9): at a periodic replan the current target stays first unless another
   // tour is clearly shorter (LocalPlannerOptions::keep_target_margin_m / _frac).
   bool target_momentum = false;
+  // Experimental (issue #9): before "complete", frontiers set aside for a path failure (no A*
+  // path, no collision-free trajectory: often the robot could not turn where it stood) are
+  // retried up to this many times, each after a move to a new vantage point. 0: off.
+  int path_retries = 0;
   bool incremental_maintenance = true;
 };
 

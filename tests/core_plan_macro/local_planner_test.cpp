@@ -3,6 +3,9 @@
 // robot standing still.
 #include "core/plan/local_planner.hpp"
 
+#include <cstdio>
+#include <string>
+
 #include <gtest/gtest.h>
 
 #include "macro_world.hpp"
@@ -225,4 +228,99 @@ TEST(LocalPlanner, PeriodicReplanKeepsTheTargetUnlessAnotherTourIsClearlyShorter
   order = {1};
   keep_first_in_tour(0, costs(1, 30), 3, false, 2.0, 0.1, order);
   EXPECT_EQ(order, (std::vector<size_t>{1}));
+}
+
+// Path-failure retry (PlanOptions::path_retries). Stage 3 plans on the map, Stage 1 on the graph:
+// here the map has a wall across the corridor 2 m east of the robot that the graph (built
+// before it stood) does not know, so every trajectory to the frontier at the east end fails and
+// the frontier is set aside for a path failure. Off, that ends the search (kNoReachableTarget)
+// where the robot stands. On, the robot first walks to a vantage point at least retry_move_m
+// away (west: east is walled off), the set-aside is released when the walk ends and Stage 3
+// tries again from there, at most path_retries times for that frontier before the search ends.
+namespace {
+struct RetryRun {
+  int retries = 0;          // retry walks
+  int other_moves = 0;      // any other new trajectory
+  double min_walk_m = 1e9;  // shortest retry walk
+  bool released = true;     // every retry walk's end released the set-aside nodes
+  LocalPlanStatus last = LocalPlanStatus::kBadInput;
+  size_t set_aside = 0;  // set-aside nodes at the end
+};
+
+RetryRun run_walled_off(int path_retries) {
+  const World w = corridor();
+  World walled = w;
+  walled.add({2.0f, -3, 0}, {2.3f, 3, 2.5f});
+  Harness h, hw;
+  Eigen::Vector3f foot(0, 0, 0);
+  h.observe(w, foot, 40000, 1);
+  hw.observe(walled, foot, 40000, 1);
+  PlanOptions po;
+  po.path_retries = path_retries;
+  LocalPlannerOptions lo;
+  lo.set_aside_expiry_s = 1e6;  // only the retry releases them here
+  LocalPlanner lp(RobotModel{}, po, 0.1, lo);
+  std::vector<storey::core::graph::FrontierCluster> east;
+  for (const auto& c : h.clusters.clusters())
+    if (c.centroid_m.x() > 5.0f) east.push_back(c);
+  EXPECT_FALSE(east.empty());
+  const auto view = hw.map.view();
+  RetryRun run;
+  double yaw = 0, t = 0;
+  int idle = 0;
+  for (int cycle = 0; cycle < 200 && idle < 12; ++cycle) {
+    LocalPlanInput in = input(h, view, foot, t);
+    in.clusters = &east;
+    in.robot_yaw_rad = yaw;
+    in.last_resort = true;
+    const size_t before = lp.set_aside().size();
+    const LocalPlanResult r = lp.plan(in);
+    run.last = r.status;
+    if (r.status != LocalPlanStatus::kNewTrajectory) {
+      idle += r.status == LocalPlanStatus::kNoReachableTarget;
+      t += 1.0;
+      continue;
+    }
+    idle = 0;
+    if (std::string(r.replan_reason).rfind("retry", 0) != 0) {
+      ++run.other_moves;
+      break;
+    }
+    ++run.retries;
+    EXPECT_GT(before, 0u);
+    const auto end = r.trajectory.pose(r.trajectory.t_end());
+    run.min_walk_m =
+        std::min(run.min_walk_m, double((end.foot_m.cast<float>() - foot).head<2>().norm()));
+    // Walked to its end: the next cycle releases the set-aside nodes (and fails again).
+    foot = end.foot_m.cast<float>();
+    yaw = end.yaw_rad;
+    t = r.trajectory.t_end() + 0.1;
+    LocalPlanInput at_end = input(h, view, foot, t);
+    at_end.clusters = &east;
+    at_end.robot_yaw_rad = yaw;
+    at_end.last_resort = true;
+    lp.plan(at_end);
+    run.released = run.released && lp.set_aside_expired() > 0;
+    t += 1.0;
+  }
+  run.set_aside = lp.set_aside().size();
+  return run;
+}
+}  // namespace
+
+TEST(LocalPlanner, PathFailuresAreRetriedFromANewVantagePointBeforeTheSearchEnds) {
+  const RetryRun off = run_walled_off(0);
+  EXPECT_EQ(off.retries, 0);
+  EXPECT_EQ(off.other_moves, 0);
+  EXPECT_EQ(off.last, LocalPlanStatus::kNoReachableTarget);
+  EXPECT_GT(off.set_aside, 0u);
+  for (int n : {1, 2}) {
+    const RetryRun on = run_walled_off(n);
+    EXPECT_EQ(on.retries, n);  // bounded: path_retries walks for the one frontier
+    EXPECT_EQ(on.other_moves, 0);
+    EXPECT_GE(on.min_walk_m, 2.0 - 0.3);  // retry_move_m, less the trajectory's end tolerance
+    EXPECT_TRUE(on.released);
+    EXPECT_EQ(on.last, LocalPlanStatus::kNoReachableTarget);
+    EXPECT_GT(on.set_aside, 0u);
+  }
 }
