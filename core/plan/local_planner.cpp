@@ -166,16 +166,34 @@ bool LocalPlanner::retry_from_elsewhere(const LocalPlanInput& in, LocalPlanResul
   if (std::none_of(set_aside_.begin(), set_aside_.end(), eligible) || !free_start(in)) return false;
   const graph::ReachableGraph& g = *in.graph;
   const double r_min = opt_.retry_move_m, d_max = 3.0 * opt_.retry_move_m;
-  std::vector<std::pair<double, graph::NodeId>> cands;
-  for (const Settled& st :
-       search_.dijkstra(sg_, std::span<const uint32_t>(&robot_node_, 1), d_max)) {
-    const graph::GraphNode& gn = g.node(st.node);
-    if ((gn.p_m.cast<double>() - in.robot_foot_m).head<2>().norm() >= r_min)
-      cands.push_back({st.dist, st.node});
+  auto far_enough = [&](graph::NodeId n) {
+    return (g.node(n).p_m.cast<double>() - in.robot_foot_m).head<2>().norm() >= r_min;
+  };
+  // First toward the nearest such frontier along G_real, from retry_near_m short of it back to
+  // the robot: the failure often lies in a long path's last turn (into a ramp's walled channel
+  // from the corridor beside it), which a start closer by takes with room to spare.
+  std::vector<graph::NodeId> cands;
+  const SetAsideEntry* nearest = nullptr;
+  for (const SetAsideEntry& e : set_aside_)
+    if (eligible(e) &&
+        (!nearest || (e.p_m - in.robot_foot_m.cast<float>()).squaredNorm() <
+                         (nearest->p_m - in.robot_foot_m.cast<float>()).squaredNorm()))
+      nearest = &e;
+  const graph::NodeId goal = g.nearest(nearest->p_m, 0.5f, 0.5f);
+  if (goal != graph::kNoId && goal < sg_.num_nodes()) {
+    const PathResult path = pair_search_.astar(sg_, robot_node_, goal);
+    double from_goal = 0;
+    for (size_t k = path.nodes.size(); k-- > 1;) {
+      if (from_goal >= opt_.retry_near_m && far_enough(path.nodes[k]))
+        cands.push_back(path.nodes[k]);
+      from_goal += (sg_.position(path.nodes[k]) - sg_.position(path.nodes[k - 1])).norm();
+    }
   }
-  std::sort(cands.begin(), cands.end());
+  // Then the nearest nodes at least retry_move_m away, by graph distance, any direction.
+  for (const Settled& st : search_.dijkstra(sg_, std::span<const uint32_t>(&robot_node_, 1), d_max))
+    if (far_enough(st.node)) cands.push_back(st.node);
   std::vector<Eigen::Vector3d> tried;  // one try per direction: a failed one's neighbours fail too
-  for (const auto& [d, n] : cands) {
+  for (graph::NodeId n : cands) {
     if (int(tried.size()) >= opt_.max_retry_vantages) break;
     const Eigen::Vector3d p = g.node(n).p_m.cast<double>();
     if (std::any_of(tried.begin(), tried.end(),

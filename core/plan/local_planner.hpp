@@ -138,7 +138,8 @@ struct LocalPlannerOptions {
   double set_aside_expiry_move_m = 2.0;  // ... once the robot is this far from where it was
   // Path-failure retry (PlanOptions::path_retries): a vantage point at least this far away.
   double retry_move_m = 2.0;
-  int max_retry_vantages = 6;  // vantage points tried per cycle (bounded work)
+  double retry_near_m = 1.5;   // ... first along G_real toward the frontier, this short of it
+  int max_retry_vantages = 8;  // vantage points tried per cycle (bounded work)
 };
 
 // Target momentum (periodic replans): `order` (indices into a tour's clusters; cost matrix

@@ -76,7 +76,7 @@ TEST(HybridGraph, ClosedDoorSplitsTheZoneAndReassignsTheCutOffPart) {
     opt.incremental_maintenance = maintain;
     MaintenanceStats st;
     uint32_t seed = 1;
-    for (const Eigen::Vector3f foot : {Eigen::Vector3f(3, 2.5f, 0), Eigen::Vector3f(5, 2.5f, 0)}) {
+    for (const Eigen::Vector3f& foot : {Eigen::Vector3f(3, 2.5f, 0), Eigen::Vector3f(5, 2.5f, 0)}) {
       h.observe(w, foot, 30000, seed++);
       st = hg.update(h.map.view(), h.map.version(), h.graph, ft, foot.cast<double>(), opt);
     }
@@ -96,8 +96,12 @@ TEST(HybridGraph, ClosedDoorSplitsTheZoneAndReassignsTheCutOffPart) {
           has_a = has_a || hg.nodes()[u].p_m.x() < 6.0;
         }
         EXPECT_FALSE(has_a && has_b) << "zone " << z.id;
-        if (has_b) EXPECT_EQ(z.state, ZoneState::kHypothetical);
-        if (has_a) EXPECT_NE(z.state, ZoneState::kHypothetical);
+        if (has_b) {
+          EXPECT_EQ(z.state, ZoneState::kHypothetical);
+        }
+        if (has_a) {
+          EXPECT_NE(z.state, ZoneState::kHypothetical);
+        }
       }
     } else {
       // Ablation: the prior's zones stay as projected.
@@ -142,11 +146,13 @@ TEST(HybridGraph, HypothesisConfirmedWhenObservedAndDiscardedAfterRepeatedEmptyO
   EXPECT_EQ(st[1].discarded, 0u);
   EXPECT_GT(st[2].discarded, 0u);
   // (The outer rows look past the end of the far wall: never observed, never discarded.)
-  for (const HybridNode& n : hg.nodes())
-    if (n.real == storey::core::graph::kNoId && std::abs(n.p_m.y() - 2.0) < 1.5)
+  for (const HybridNode& n : hg.nodes()) {
+    if (n.real == storey::core::graph::kNoId && std::abs(n.p_m.y() - 2.0) < 1.5) {
       EXPECT_LT(n.p_m.x(), 4.0 + opt.hyp_promote_radius_m + 0.1)
           << "hypothesis over the pit at y " << n.p_m.y() << " z " << n.p_m.z() << " state "
           << int(n.state);
+    }
+  }
   EXPECT_LT(hg.hypotheses_alive(), total);
   // The same map version twice counts once.
   const MaintenanceStats again =

@@ -54,7 +54,9 @@ TEST_P(CanTransferTest, LostFrameDropsTransferAndNextOneRecovers) {
   for (size_t i = 0; i < n; ++i) {
     if (i == 1) continue;  // lost on the bus
     const auto res = r.push(a[i]);
-    if (i > 1) EXPECT_NE(res, CanReassembler::Result::complete);
+    if (i > 1) {
+      EXPECT_NE(res, CanReassembler::Result::complete);
+    }
   }
   CanReassembler::Result last{};
   for (size_t i = 0; i < n; ++i) last = r.push(c[i]);

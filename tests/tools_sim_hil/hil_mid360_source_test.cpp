@@ -42,7 +42,9 @@ TEST(HilMid360Source, BoxRoomPacketsDecodeWithoutLoss) {
     ASSERT_EQ(info.reason, lidar::DropReason::none) << "packet " << k;
     EXPECT_EQ(info.data_type, 1);
     if (info.udp_cnt == 0) ++frame_starts;
-    if (k > 0) EXPECT_EQ(info.timestamp_ns - prev_ts, 480'000u);  // 96 shots at 200 kHz
+    if (k > 0) {
+      EXPECT_EQ(info.timestamp_ns - prev_ts, 480'000u);  // 96 shots at 200 kHz
+    }
     prev_ts = info.timestamp_ns;
     for (uint32_t i = 0; i < info.points; ++i) {
       const double e =
