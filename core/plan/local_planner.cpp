@@ -205,17 +205,25 @@ bool LocalPlanner::retry_from_elsewhere(const LocalPlanInput& in, LocalPlanResul
     if (!try_target(in, Viewpoint{p, std::atan2(dir.y(), dir.x()), n}, out, &why)) continue;
     for (SetAsideEntry& e : set_aside_)
       if (eligible(e)) ++e.retries, e.retry_pending = true;
-    retrying_ = has_target_ = committed_ = true;  // driven to its end, whatever it sees on the way
+    retrying_ = true;
     climbing_ = false;
-    target_cluster_ = -1;
-    target_m_ = out.target_m;
-    current_ = out.trajectory;
-    planned_at_s_ = in.t_s;
-    out.replan_reason = "retry: to a new vantage point for frontiers no path reached";
-    out.status = LocalPlanStatus::kNewTrajectory;
+    adopt_move(in, out, "retry: to a new vantage point for frontiers no path reached",
+               /*committed=*/true);  // driven to its end, whatever it sees on the way
     return true;
   }
   return false;
+}
+
+void LocalPlanner::adopt_move(const LocalPlanInput& in, LocalPlanResult& out, const char* reason,
+                              bool committed) {
+  has_target_ = true;
+  committed_ = committed;
+  target_cluster_ = -1;
+  target_m_ = out.target_m;
+  current_ = out.trajectory;
+  planned_at_s_ = in.t_s;
+  out.replan_reason = reason;
+  out.status = LocalPlanStatus::kNewTrajectory;
 }
 
 void LocalPlanner::release_retry() {
@@ -521,15 +529,8 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   out.clusters_total = int(in.clusters->size());
   // An escape or a climb: a trajectory to a pose, not to a cluster, driven to its end.
   auto commit = [&](const char* reason) {
-    has_target_ = true;
-    committed_ = plan_opt_.climb_blind;
     climbing_ = false;
-    target_cluster_ = -1;
-    target_m_ = out.target_m;
-    current_ = out.trajectory;
-    planned_at_s_ = in.t_s;
-    out.replan_reason = reason;
-    out.status = LocalPlanStatus::kNewTrajectory;
+    adopt_move(in, out, reason, plan_opt_.climb_blind);
     return out;
   };
   auto commit_climb = [&](const char* reason) {
@@ -672,14 +673,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   };
   auto to_climb = [&](const char* reason) {
     if (!climb_start_) return commit_climb(reason);
-    has_target_ = true;
-    committed_ = false;
-    target_cluster_ = -1;
-    target_m_ = out.target_m;
-    current_ = out.trajectory;
-    planned_at_s_ = in.t_s;
-    out.replan_reason = "back to the flight left for last: no other target on this floor";
-    out.status = LocalPlanStatus::kNewTrajectory;
+    adopt_move(in, out, "back to the flight left for last: no other target on this floor", false);
     return out;
   };
 

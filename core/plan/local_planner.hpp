@@ -183,6 +183,10 @@ class LocalPlanner {
   // Nothing else left: move to a new vantage point before the path failures end the run.
   bool retry_from_elsewhere(const LocalPlanInput& in, LocalPlanResult& out);
   void release_retry();
+  // out's trajectory (an escape, a climb, a walk: to a pose, not to a cluster) becomes the
+  // current one; committed: driven to its end.
+  void adopt_move(const LocalPlanInput& in, LocalPlanResult& out, const char* reason,
+                  bool committed);
   const graph::FrontierCluster* find_cluster(const LocalPlanInput& in, int32_t id) const;
   // The target cluster, under a new id if its nodes changed (see track_radius_m).
   const graph::FrontierCluster* track_target(const LocalPlanInput& in);
