@@ -142,7 +142,7 @@ int LocalPlanner::expire_set_aside(const LocalPlanInput& in) {
     if (!expire)
       set_aside_[kept++] = e;
     else if (e.retries > 0)
-      retried_.push_back({e.p_m, e.retries});
+      remember_retried(e);
   }
   const int n = int(set_aside_.size() - kept);
   set_aside_.resize(kept);
@@ -153,8 +153,9 @@ int LocalPlanner::expire_set_aside(const LocalPlanInput& in) {
 // Stage 3 failed for the last clusters from where the robot stands. That is often the robot's
 // fault, not the clusters': facing down a ramp too narrow to turn on, by a wall end it cannot
 // curve away from (test_ramp: the run ended "complete" with the upper floor unexplored). Before
-// the failures end the run, walk to a new vantage point, the nearest G_real node at least
-// retry_move_m away that a trajectory reaches, and release those set-asides when the walk ends.
+// the failures end the run, walk to a new vantage point a trajectory reaches (along G_real toward
+// the nearest failed frontier first, then any node at least retry_move_m away) and release those
+// set-asides when the walk ends.
 bool LocalPlanner::retry_from_elsewhere(const LocalPlanInput& in, LocalPlanResult& out) {
   if (!in.last_resort || plan_opt_.path_retries <= 0 || robot_node_ >= sg_.num_nodes())
     return false;
@@ -226,6 +227,17 @@ void LocalPlanner::adopt_move(const LocalPlanInput& in, LocalPlanResult& out, co
   out.status = LocalPlanStatus::kNewTrajectory;
 }
 
+// One entry per position: a node retried again keeps its latest (largest) count, so the list
+// grows with the places retried, not with the retries.
+void LocalPlanner::remember_retried(const SetAsideEntry& e) {
+  for (Retried& q : retried_)
+    if ((q.p_m - e.p_m).squaredNorm() < 1e-6f) {
+      q.retries = std::max(q.retries, e.retries);
+      return;
+    }
+  retried_.push_back({e.p_m, e.retries});
+}
+
 void LocalPlanner::release_retry() {
   size_t kept = 0;
   for (const SetAsideEntry& e : set_aside_) {
@@ -233,7 +245,7 @@ void LocalPlanner::release_retry() {
       set_aside_[kept++] = e;
       continue;
     }
-    retried_.push_back({e.p_m, e.retries});
+    remember_retried(e);
     ++expired_total_;
   }
   set_aside_.resize(kept);

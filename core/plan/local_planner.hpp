@@ -183,6 +183,7 @@ class LocalPlanner {
   // Nothing else left: move to a new vantage point before the path failures end the run.
   bool retry_from_elsewhere(const LocalPlanInput& in, LocalPlanResult& out);
   void release_retry();
+  void remember_retried(const SetAsideEntry& e);
   // out's trajectory (an escape, a climb, a walk: to a pose, not to a cluster) becomes the
   // current one; committed: driven to its end.
   void adopt_move(const LocalPlanInput& in, LocalPlanResult& out, const char* reason,
