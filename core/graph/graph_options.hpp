@@ -16,7 +16,7 @@ struct GraphOptions {
   double surface_radius_factor = 1.0;         // radius of Omega_i = factor * r_e
   int probes = 12;                            // radial probes for C_exp
   int theta_min = 2;                          // Theta_min, open directions for C_exp
-  // Experimental (issue #9, set by plan.climb_blind): one open probe that climbed a stair step
+  // Experimental (issue #9, set by plan.climb_blind): one open probe that climbed two stair steps
   // satisfies C_exp (a flight is one probe wide), and a probe follows a flight to its top.
   bool climb_frontiers = false;
   // Experimental (issue #9, graph.close_probes_at_holes): a C_exp probe entering unknown space

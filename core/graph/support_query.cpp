@@ -239,6 +239,10 @@ bool SupportQuery::probe_open(const Eigen::Vector3f& from, const Eigen::Vector3f
 
 namespace {
 constexpr float kStairGrade = 0.466f;  // tan(25 deg)
+// Steps at stair grade before a probe counts as climbing a flight: one is a curb, or the low end
+// of a ramp's side rising under a step (test_ramp: C_exp frontiers along the ramp no view
+// resolved).
+constexpr int kStairSteps = 2;
 }  // namespace
 
 bool SupportQuery::probe_open_climbing(const Eigen::Vector3f& foot, const Eigen::Vector2f& dir,
@@ -252,7 +256,7 @@ bool SupportQuery::probe_open_climbing(const Eigen::Vector3f& foot, const Eigen:
   const int need_unknown = std::max(1, int(std::ceil(min_unknown_m * per_m)));
   const float max_rise = 2.0f * step_;
   float s0 = 0, s_climb = 0, zc = foot.z();
-  int free_total = 0, unknown_run = 0;
+  int free_total = 0, unknown_run = 0, stair_steps = 0;
   // The probe reaches length_m past its last climb: it follows a flight to its top (a node low
   // on a 5 m flight sees only known treads within 3 m).
   // (GraphOptions::climb_frontiers; else length_m from the node).
@@ -275,7 +279,9 @@ bool SupportQuery::probe_open_climbing(const Eigen::Vector3f& foot, const Eigen:
       // riser's top, N(v) < N_min): terrain not yet observed, what the probe looks for.
       // A stair's step: steeper than tan(25 deg) since the last climb (flights ~30 deg; a ramp,
       // 5-20 deg in buildings, keeps the ground ahead in the LiDAR's view: judged as level).
-      if (climbed && rise >= kStairGrade * std::max(s_hit - s_climb, vs_)) *climbed = true;
+      if (rise >= kStairGrade * std::max(s_hit - s_climb, vs_) && ++stair_steps >= kStairSteps &&
+          climbed)
+        *climbed = true;
       if (top->state == TravState::kUnobserved) return free_total >= need_free;
       zc = top->p_m.z();
       s_climb = s_hit;

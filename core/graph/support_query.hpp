@@ -99,7 +99,7 @@ class SupportQuery {
   // reaching unobserved terrain (open). Otherwise as probe_open. Without this, a stair's risers
   // close every probe at body height up the flight and the stairs never become a frontier (paper
   // III-C: stairs are the way to the next floor). `climbed` (optional) tells whether an open
-  // probe had climbed at least one stair step (steeper than 25 deg) first: it runs up a flight.
+  // probe had climbed two stair steps (each steeper than 25 deg) first: it runs up a flight.
   bool probe_open_climbing(const Eigen::Vector3f& foot, const Eigen::Vector2f& dir, float length_m,
                            float height_m, float min_free_m, float min_unknown_m,
                            bool* climbed = nullptr);

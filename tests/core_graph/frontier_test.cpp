@@ -308,9 +308,31 @@ TEST(TopologicalFrontiers, ProbeClimbsAStairFlightToItsUnknownTreads) {
   // The level probe stops at a riser: closed.
   EXPECT_FALSE(
       q.probe_open(foot + Vector3f(0, 0, 0.3f), foot + Vector3f(3.0f, 0, 0.3f), min_free, 0.3f));
-  EXPECT_TRUE(q.probe_open_climbing(foot, up, 3.0f, 0.3f, min_free, 0.3f));
+  bool climbed = false;
+  EXPECT_TRUE(q.probe_open_climbing(foot, up, 3.0f, 0.3f, min_free, 0.3f, &climbed));
+  EXPECT_TRUE(climbed);  // up a flight: alone it satisfies C_exp (GraphOptions::climb_frontiers)
   // Toward the observed wall behind: closed either way.
-  EXPECT_FALSE(q.probe_open_climbing(foot, back, 3.0f, 0.3f, min_free, 0.3f));
+  EXPECT_FALSE(q.probe_open_climbing(foot, back, 3.0f, 0.3f, min_free, 0.3f, &climbed));
+}
+
+// One step up is no flight: a probe over a curb (or onto the low end of a ramp's side, where the
+// ramp's solid rises less than a step) into unknown space is open but has not climbed stairs.
+// With climb_frontiers such probes made C_exp frontiers along test_ramp's ramp that no view
+// resolved (the upper floor was left at 1-32 %, docs/RESULTS.md session 11).
+TEST(TopologicalFrontiers, ProbeOverACurbIsOpenButClimbsNoFlight) {
+  World w;
+  w.add({-3.2f, -2, -0.3f}, {2.0f, 2, 0.0f});  // floor, ending at x = 2 (unknown beyond)
+  w.add({0.0f, -2, -0.3f}, {1.0f, 2, 0.35f});  // a 0.35 m curb, 1 m deep
+  w.add({-3.2f, -2, 0}, {-3.0f, 2, 2.5f});     // a wall behind the robot
+  GraphOptions o;
+  Harness h(o);
+  // Seen from high up: the space over the curb is observed free, beyond the floor's end unknown.
+  h.observe(w, Vector3f(-1.5f, 0, 2.0f), Vector3f(-1.5f, 0, 0), 150000, 7, 6.0f);
+  SupportQuery q(h.map.view(), o);
+  bool climbed = true;
+  EXPECT_TRUE(q.probe_open_climbing(Vector3f(-0.3f, 0, 0), Eigen::Vector2f(1, 0), 3.0f, 0.3f, 0.2f,
+                                    0.3f, &climbed));
+  EXPECT_FALSE(climbed);
 }
 
 // A wall seen only at grazing angles keeps voxel-sized holes; behind them lies the wall's solid,

@@ -83,7 +83,7 @@ TEST(ExploreHouse, BothFloorsWithTheBlindClimb) {
   EXPECT_EQ(m.collisions, 0u);
   EXPECT_EQ(m.falls, 0u);
   ASSERT_EQ(m.floors_total, 2);
-  // Measured (seed 1): complete at 205.0 s, floors 0.943 / 0.942 (docs/RESULTS.md).
+  // Measured (seed 1): complete at 295.0 s, floors 0.961 / 0.956 (docs/RESULTS.md, session 11).
   EXPECT_EQ(m.floors_explored, 2);
   for (const auto& f : m.per_floor) EXPECT_GE(f.traversable_coverage, 0.9) << "floor at " << f.z_m;
   const SimRunResult b = run_exploration(o);
