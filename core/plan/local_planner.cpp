@@ -592,6 +592,9 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     } else if (!committed_ && !climb_start_ && reached && tc && try_climb(false)) {
       if (!other_targets(in, tc->id))
         return commit_climb("climb on: a frontier on a flight is not seen from on it");
+      if (climb_deferrals_ >= opt_.max_climb_deferrals)
+        return commit_climb("climb on: left for last often enough, the floor's frontiers return");
+      ++climb_deferrals_;
       defer_climb();  // other frontiers first: the climb is one way
       set_aside_cluster(in, *tc, SetAsideReason::kStillFrontierAtTarget);
       reason = "climb left for last: other frontiers on this floor first";
@@ -656,6 +659,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   if (retrying_) release_retry();  // the retry move ended: plan from the new vantage point
   if (climbing_) {  // a climb ended (done, overdue, or dropped on a predicted collision)
     climbing_ = false;
+    climb_deferrals_ = 0;
     climb_done_s_ = in.t_s;
     const float top = float(current_.pose(current_.t_end()).foot_m.z());
     ClimbedFlight f{{}, top};

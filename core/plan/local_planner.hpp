@@ -120,18 +120,22 @@ struct LocalPlannerOptions {
   // the target's is the same frontier: the target is kept, not "observed" and replanned (on
   // test_ramp's landing ids churned every cycle and the robot turned between two targets).
   double track_radius_m = 1.0;
-  double reached_radius_m = 0.5;         // robot this close to the viewpoint = reached
-  double set_aside_radius_m = 0.3;       // a frontier node this close to a set-aside one is ignored
-  int max_failures = 2;                  // Stage 3 failures before a cluster is set aside
-  int max_stage3_attempts = 6;           // viewpoints tried per cycle (bounded work)
-  double escape_radius_m = 0.3;          // start pose in collision: free start searched this far
-  double escape_turn_radius_m = 0.8;     // cannot turn on the spot: a turning place this far
-  double start_blame_radius_m = 0.7;     // every try hits an obstacle this close to the start:
-                                         // the start is boxed in, not the clusters (escape)
-  int max_start_escapes = 3;             // ... at most this many escapes in a row
-  double landing_step_m = 0.6;           // climb_on: past the last support seen on a flight
-  int max_climbs = 3;                    // climb_on moves in a row without a new target
-  double climb_settle_s = 15.0;          // after a climb: wait this long for the landing's graph
+  double reached_radius_m = 0.5;      // robot this close to the viewpoint = reached
+  double set_aside_radius_m = 0.3;    // a frontier node this close to a set-aside one is ignored
+  int max_failures = 2;               // Stage 3 failures before a cluster is set aside
+  int max_stage3_attempts = 6;        // viewpoints tried per cycle (bounded work)
+  double escape_radius_m = 0.3;       // start pose in collision: free start searched this far
+  double escape_turn_radius_m = 0.8;  // cannot turn on the spot: a turning place this far
+  double start_blame_radius_m = 0.7;  // every try hits an obstacle this close to the start:
+                                      // the start is boxed in, not the clusters (escape)
+  int max_start_escapes = 3;          // ... at most this many escapes in a row
+  double landing_step_m = 0.6;        // climb_on: past the last support seen on a flight
+  int max_climbs = 3;                 // climb_on moves in a row without a new target
+  double climb_settle_s = 15.0;       // after a climb: wait this long for the landing's graph
+  // A climb deferred this many times is taken the next time it is found: the floor's last
+  // clusters, set aside at their viewpoints, came back whenever the map near them changed (the
+  // office, seed 2: deferred at least 4 times in 600 s, the upper floor never reached).
+  int max_climb_deferrals = 2;
   double keep_target_margin_m = 2.0;     // periodic replan: the current target stays first
   double keep_target_margin_frac = 0.1;  // unless another tour is shorter by max(m, frac * tour)
   double set_aside_expiry_s = 30.0;      // a set-aside node may expire after this [s] ...
@@ -262,6 +266,7 @@ class LocalPlanner {
     double yaw_rad;
   };
   std::optional<DeferredClimb> deferred_climb_;
+  int climb_deferrals_ = 0;  // climbs deferred since the last climb
   bool climb_start_ = false;
   bool climbing_ = false;     // the committed move is a climb
   double climb_done_s_ = -1;  // when the last climb ended
