@@ -16,11 +16,13 @@ struct GraphOptions {
   double surface_radius_factor = 1.0;         // radius of Omega_i = factor * r_e
   int probes = 12;                            // radial probes for C_exp
   int theta_min = 2;                          // Theta_min, open directions for C_exp
-  // Experimental (issue #9, set by plan.climb_blind): one open probe that climbed two stair steps
-  // satisfies C_exp (a flight is one probe wide), and a probe follows a flight to its top.
+  // Beyond the paper, on in config/default.yaml (issue #9, set by plan.climb_blind): one open probe
+  // that climbed two stair steps satisfies C_exp (a flight is one probe wide), and a probe follows
+  // a flight to its top.
   bool climb_frontiers = false;
-  // Experimental (issue #9, graph.close_probes_at_holes): a C_exp probe entering unknown space
-  // through a voxel-sized gap in a surface (a wall seen at grazing angles) is closed.
+  // Beyond the paper, on in config/default.yaml (issue #9, graph.close_probes_at_holes): a C_exp
+  // probe entering unknown space through a voxel-sized gap in a surface (a wall seen at grazing
+  // angles) is closed.
   bool close_probes_at_holes = false;
   double probe_length_m = 3.0;      // probe length for C_exp
   int cluster_capacity = 8;         // maximum frontier nodes per cluster
@@ -40,11 +42,11 @@ struct GraphOptions {
                                       // for at most this long (a sparsely observed gap)
   double surface_tolerance_m = 0.03;  // slack on the step height for surface noise
   double root_radius_m = 1.0;         // the robot's node: nearest within this, else a new one
-  // Experimental (set by plan.climb_blind). The robot's node where the nearest one lies more
-  // than half a step below or above it and farther than node_clearance_m: a new node on the
-  // support under the feet. A robot that climbed a flight blind (PlanOptions::climb_blind)
-  // stands on a landing G_real never reached, and the flight's top node is no place to grow the
-  // new floor's graph from.
+  // Beyond the paper, on in config/default.yaml (set by plan.climb_blind). The robot's node where
+  // the nearest one lies more than half a step below or above it and farther than node_clearance_m:
+  // a new node on the support under the feet. A robot that climbed a flight blind
+  // (PlanOptions::climb_blind) stands on a landing G_real never reached, and the flight's top node
+  // is no place to grow the new floor's graph from.
   bool root_off_graph = false;
   double floor_height_hint_m = 3.0;  // floor id hint = round(z / this) (planning refines floors)
   // A cut that leaves the robot in the smaller part is more likely a transient (a node near the

@@ -4,14 +4,17 @@
 namespace storey::core::map {
 
 struct MapOptions {
-  // Experimental (issue #9, set by plan.climb_blind): a riser's short top piece is judged with
-  // the riser below it (riser_plane), and a sheet over observed open air is a ledge, not a step.
+  // Beyond the paper, on in config/default.yaml (issue #9, set by plan.climb_blind): a riser's
+  // short top piece is judged with the riser below it (riser_plane), and a sheet over observed open
+  // air is a ledge, not a step.
   bool pool_short_risers = false;
-  // Experimental (set by plan.climb_blind): the C_reach seed prefers the support under the body
-  // at the feet's level to C_reach members (a landing reached by a blind climb).
+  // Beyond the paper, on in config/default.yaml (set by plan.climb_blind): the C_reach seed prefers
+  // the support under the body at the feet's level to C_reach members (a landing reached by a blind
+  // climb).
   bool seed_under_feet = false;
-  // Experimental (issue #9, map.spill_is_surface): a voxel under N_min low over a level,
-  // well-observed floor is that floor's spill across a voxel boundary, judged as a surface.
+  // Beyond the paper, on in config/default.yaml (issue #9, map.spill_is_surface): a voxel under
+  // N_min low over a level, well-observed floor is that floor's spill across a voxel boundary,
+  // judged as a surface.
   bool spill_is_surface = false;
   // --- occupancy (ray casting) ---
   double voxel_size_m = 0.1;    // map resolution

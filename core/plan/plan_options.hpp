@@ -43,17 +43,20 @@ struct PlanOptions {
   double zone_visit_radius_m = 1.5;      // robot this close to c_k: zone visited (state C test)
   // Ablation switches (paper Table IV).
   bool use_prior = true;
-  // Experimental (issue #9): a frontier on a flight of stairs is not seen from on it (the body
-  // pitches with the flight, the LiDAR looks over the treads); climb on up the flight's axis onto
-  // the landing, blind past the last support seen, and drive escapes to their end. Off by
-  // default: the two-floor house is explored with it, test_ramp's ramp is not (docs/RESULTS.md).
+  // Beyond the paper, on in config/default.yaml (issue #9): a frontier on a flight of stairs is not
+  // seen from on it (the body pitches with the flight, the LiDAR looks over the treads); climb on
+  // up the flight's axis onto the landing, blind past the last support seen, and drive escapes to
+  // their end. Off here (the paper's method, what unit tests construct); docs/RESULTS.md
+  // session 11.
   bool climb_blind = false;
-  // Experimental (issue #9): at a periodic replan the current target stays first unless another
-  // tour is clearly shorter (LocalPlannerOptions::keep_target_margin_m / _frac).
+  // Beyond the paper, on in config/default.yaml (issue #9): at a periodic replan the current target
+  // stays first unless another tour is clearly shorter (LocalPlannerOptions::keep_target_margin_m /
+  // _frac).
   bool target_momentum = false;
-  // Experimental (issue #9): before "complete", frontiers set aside for a path failure (no A*
-  // path, no collision-free trajectory: often the robot could not turn where it stood) are
-  // retried up to this many times, each after a move to a new vantage point. 0: off.
+  // Beyond the paper, on in config/default.yaml (issue #9): before "complete", frontiers set aside
+  // for a path failure (no A* path, no collision-free trajectory: often the robot could not turn
+  // where it stood) are retried up to this many times, each after a move to a new vantage point. 0:
+  // off.
   int path_retries = 0;
   bool incremental_maintenance = true;
 };
