@@ -430,7 +430,7 @@ void Autonomy::count_exhausted(const WorldModel& w, ExplorationStatus& s) {
   for (const core::graph::FrontierCluster& c : w.clusters) {
     bool open = false, connected = false;
     for (core::graph::NodeId n : c.nodes) {
-      if (local.set_aside_at(g.node(n).p_m)) continue;
+      if (local.ignored(g.node(n).p_m)) continue;
       open = true;
       connected = connected || (rooted && find(n) == root);
     }

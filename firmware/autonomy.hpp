@@ -67,8 +67,9 @@ struct ExplorationStatus {
   core::plan::ExplorationStatus last_plan = core::plan::ExplorationStatus::kExploring;
   const char* plan_reason = "";
   uint32_t nodes = 0, edges = 0, frontier_nodes = 0, clusters = 0;
-  // Clusters whose every node the local layer set aside / with no node connected to the robot
-  // through G_real (computed by the plan task when the policy has nothing to do).
+  // Clusters whose every node the local layer set aside (or left on a flight climbed blind) / with
+  // no node connected to the robot through G_real (computed by the plan task when the policy has
+  // nothing to do).
   uint32_t clusters_set_aside = 0, clusters_unreachable = 0;
   // A baseline's own set-aside goals (GoalDriver::SetAsideCounts; all -1 for the storey method).
   int32_t goals_stood_at = -1, goals_overdue = -1, goals_no_trajectory = -1;

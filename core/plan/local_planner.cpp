@@ -391,7 +391,9 @@ bool LocalPlanner::climb_on(const LocalPlanInput& in, LocalPlanResult& out, bool
   const double vs = view.voxel_size_m(), step = robot_.step_height_m;
   const Eigen::Vector2d o =
       axis->origin + axis->dir * (foot.head<2>() - axis->origin).dot(axis->dir);
-  if (on_flight_only) {  // a tread lower behind the robot: it stands on the flight
+  // On the flight: a tread lower behind the robot, or a blind climb's path below its landing
+  // (the treads walked over blind are not in the map).
+  if (on_flight_only && !below_climbed_landing(foot)) {
     const Eigen::Vector2d b = o - 0.5 * axis->dir;
     const auto sb = view.support_surface_near(
         Eigen::Vector3f(float(b.x()), float(b.y()), float(foot.z() - step)), 0.5 * step + 0.05);
@@ -419,17 +421,20 @@ bool LocalPlanner::climb_on(const LocalPlanInput& in, LocalPlanResult& out, bool
     edges += view.is_step_edge(
         view.key_of(Eigen::Vector3f(float(p.x()), float(p.y()), float(p.z() - 0.01))));
   if (edges < 3) return false;
-  // Onto the landing, blind: rays crossed the body's space there, no drop observed below.
+  // Onto the landing, blind: rays crossed the body's space there, no drop observed below. A
+  // wall seen on it ends the landing there (test_stair's ends 0.8 m past the top tread: a climb
+  // planned before that wall was seen ran into it and was dropped mid-flight).
   const double body_lo = z + step, body_hi = z + robot_.body_height_m;
   for (double s = s_last + vs; s <= s_last + opt_.landing_step_m + 1e-9; s += vs) {
     const Eigen::Vector2d q = o + s * axis->dir;
-    bool seen = false;
-    for (double h = body_lo; h <= body_hi; h += vs) {
+    bool seen = false, wall = false;
+    for (double h = body_lo; h <= body_hi && !wall; h += vs) {
       const map::Occupancy oc =
           view.occupancy(Eigen::Vector3f(float(q.x()), float(q.y()), float(h)));
-      if (oc == map::Occupancy::kOccupied) return false;
+      wall = oc == map::Occupancy::kOccupied;
       seen |= oc == map::Occupancy::kFree;
     }
+    if (wall) break;
     if (!seen) return false;
     for (double h = z - step - vs; h >= z - 1.0; h -= vs)
       if (view.occupancy(Eigen::Vector3f(float(q.x()), float(q.y()), float(h))) ==
@@ -450,7 +455,30 @@ bool LocalPlanner::climb_on(const LocalPlanInput& in, LocalPlanResult& out, bool
       if (ds > 0 && ds <= 0.2 + 1e-6) p.z() = std::max(p.z(), q.z());
     }
   }
-  return straight_walk(in, pts, std::atan2(axis->dir.y(), axis->dir.x()), out);
+  // The longest walk the body fits (its front stops short of a wall), ending at least
+  // min_landing_m past where the flight reached the landing's height.
+  double s_reach = s_top;
+  for (const Eigen::Vector3d& p : sup)
+    if (p.z() >= z - 0.03) {
+      s_reach = (p.head<2>() - o).dot(axis->dir);
+      break;
+    }
+  const double yaw = std::atan2(axis->dir.y(), axis->dir.x());
+  for (int tries = 0;
+       tries < 16 && pts.size() > 1 &&
+       (pts.back().head<2>() - o).dot(axis->dir) >= s_reach + opt_.min_landing_m - 1e-6;
+       ++tries, pts.pop_back())
+    if (straight_walk(in, pts, yaw, out)) return true;
+  return false;
+}
+
+bool LocalPlanner::below_climbed_landing(const Eigen::Vector3d& foot) const {
+  for (const ClimbedFlight& f : climbed_) {
+    if (foot.z() > f.top_z_m - robot_.step_height_m) continue;
+    for (const Eigen::Vector3f& q : f.path_m)
+      if ((q.cast<double>() - foot).head<2>().norm() < 0.5) return true;
+  }
+  return false;
 }
 
 bool LocalPlanner::on_climbed_flight(const Eigen::Vector3f& p) const {
@@ -668,6 +696,9 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
       if (q.z() < top - 0.05f) f.path_m.push_back(q);  // the flight, not the landing
     }
     climbed_.push_back(std::move(f));
+    // Dropped on the flight (a wall seen ahead): no node grows there; on up from here.
+    if (below_climbed_landing(in.robot_foot_m) && try_climb(true))
+      return commit_climb("climb on: the climb stopped on the flight, on up it");
   }
   // No other target left on this floor: back to the flight left for last, or up it from there.
   auto climb_last = [&]() {

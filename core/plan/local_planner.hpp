@@ -130,8 +130,9 @@ struct LocalPlannerOptions {
                                       // the start is boxed in, not the clusters (escape)
   int max_start_escapes = 3;          // ... at most this many escapes in a row
   double landing_step_m = 0.6;        // climb_on: past the last support seen on a flight
-  int max_climbs = 3;                 // climb_on moves in a row without a new target
-  double climb_settle_s = 15.0;       // after a climb: wait this long for the landing's graph
+  double min_landing_m = 0.2;    // ... shortened to fit before a wall, not below this past the top
+  int max_climbs = 3;            // climb_on moves in a row without a new target
+  double climb_settle_s = 15.0;  // after a climb: wait this long for the landing's graph
   // A climb deferred this many times is taken the next time it is found: the floor's last
   // clusters, set aside at their viewpoints, came back whenever the map near them changed (the
   // office, seed 2: deferred at least 4 times in 600 s, the upper floor never reached).
@@ -167,6 +168,10 @@ class LocalPlanner {
   // node nearest p (within set_aside_radius_m), or nullptr.
   const std::vector<SetAsideEntry>& set_aside() const { return set_aside_; }
   const SetAsideEntry* set_aside_at(const Eigen::Vector3f& p) const;
+  // A frontier node the planner no longer targets: set aside, or on a flight climbed blind.
+  bool ignored(const Eigen::Vector3f& p) const {
+    return set_aside_at(p) != nullptr || on_climbed_flight(p);
+  }
   void set_stage_probe(StageProbe* probe) { probe_ = probe; }
 
  private:
@@ -175,12 +180,12 @@ class LocalPlanner {
     size_t cluster_index;
     uint32_t rep;  // representative node (nearest the centroid)
   };
-  bool ignored(const Eigen::Vector3f& p) const {
-    return set_aside_at(p) != nullptr || on_climbed_flight(p);
-  }
   // Over a flight climbed blind (within 0.8 m of the climb's path below the landing), no
   // higher than its landing.
   bool on_climbed_flight(const Eigen::Vector3f& p) const;
+  // Still on a flight climbed blind: its landing more than a step above (a climb dropped
+  // mid-flight, its treads below never seen from above).
+  bool below_climbed_landing(const Eigen::Vector3d& foot) const;
   void set_aside_cluster(const LocalPlanInput& in, const graph::FrontierCluster& c,
                          SetAsideReason reason, const Eigen::Vector3f& hit_m = kNoHitM);
   int expire_set_aside(const LocalPlanInput& in);
