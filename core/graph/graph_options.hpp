@@ -53,6 +53,14 @@ struct GraphOptions {
   // robot lost and not yet re-linked) than a real one: the larger part is kept this many updates
   // before it is pruned (a real cut, e.g. a closed door, still prunes it after the window).
   int prune_persistence_updates = 30;
+  // Beyond the paper, off (graph.keep_reachable_cut; session 12): nodes cut off from the robot in
+  // G_real whose support is still in C_reach (grown from the robot over the map's voxels) are
+  // kept, not pruned: a cut of the graph, not of the terrain. Maze's 1.5 m ramp holds a chain one
+  // node wide; revalidation near its walls cut it with the robot on the short side, and the
+  // ground floor's graph, with every frontier on it, was pruned and never regrew. Expansion can
+  // re-link the parts, but nothing makes it: in the office (seed 2) a part that stayed cut held
+  // the floor's last cluster, unreachable, and the run ended "complete" at 58 s with 27 % seen.
+  bool keep_reachable_cut = false;
   // --- incremental update budgets (bounded work per map cycle) ---
   // (~23 us per operation at 0.1 m voxels: these bound a cycle to ~5 ms CPU; PERFORMANCE.md)
   int max_expansions_per_update = 40;     // nodes expanded per update (queue carries over)

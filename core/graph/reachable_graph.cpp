@@ -419,7 +419,14 @@ void ReachableGraph::prune_disconnected(GraphUpdateStats& st) {
       }
     }
   }
-  if (bfs_.size() == node_count_) {
+  // Cut off, but still in C_reach (GraphOptions::keep_reachable_cut): kept.
+  auto cut = [&](NodeId i) {
+    return nodes_[i].alive && mark_[i] != mark_epoch_ &&
+           !(opt_.keep_reachable_cut && nodes_[i].state == ElementState::kConfirmed);
+  };
+  size_t n_cut = 0;
+  for (NodeId i = 0; i < nodes_.size(); ++i) n_cut += cut(i);
+  if (n_cut == 0) {
     deferred_updates_ = 0;
     return;
   }
@@ -430,7 +437,7 @@ void ReachableGraph::prune_disconnected(GraphUpdateStats& st) {
   }
   deferred_updates_ = 0;
   for (NodeId i = 0; i < nodes_.size(); ++i)
-    if (nodes_[i].alive && mark_[i] != mark_epoch_) {
+    if (cut(i)) {
       remove_node(i);
       ++st.disconnected;
     }

@@ -393,11 +393,17 @@ bool LocalPlanner::climb_on(const LocalPlanInput& in, LocalPlanResult& out, bool
       axis->origin + axis->dir * (foot.head<2>() - axis->origin).dot(axis->dir);
   // On the flight: a tread lower behind the robot, or a blind climb's path below its landing
   // (the treads walked over blind are not in the map).
+  // Behind: 0.3-0.6 m back, one or two treads lower (half a metre back was two treads down on
+  // the house's flight at some positions, and the robot stood on it with no climb found).
   if (on_flight_only && !below_climbed_landing(foot)) {
-    const Eigen::Vector2d b = o - 0.5 * axis->dir;
-    const auto sb = view.support_surface_near(
-        Eigen::Vector3f(float(b.x()), float(b.y()), float(foot.z() - step)), 0.5 * step + 0.05);
-    if (!sb || sb->height_m > foot.z() - 0.5 * step) return false;
+    bool lower = false;
+    for (double d = 0.3; d <= 0.6 + 1e-9 && !lower; d += 0.15) {
+      const Eigen::Vector2d b = o - d * axis->dir;
+      const auto sb = view.support_surface_near(
+          Eigen::Vector3f(float(b.x()), float(b.y()), float(foot.z() - step)), step + 0.05);
+      lower = sb && sb->height_m <= foot.z() - 0.5 * step;
+    }
+    if (!lower) return false;
   }
   // Up the axis over the support the map holds; unseen treads (edge-on) are bridged up to 0.45 m.
   std::vector<Eigen::Vector3d> pts{foot};
@@ -425,6 +431,8 @@ bool LocalPlanner::climb_on(const LocalPlanInput& in, LocalPlanResult& out, bool
   // wall seen on it ends the landing there (test_stair's ends 0.8 m past the top tread: a climb
   // planned before that wall was seen ran into it and was dropped mid-flight).
   const double body_lo = z + step, body_hi = z + robot_.body_height_m;
+  const size_t n_flight = pts.size();
+  bool unseen = false;
   for (double s = s_last + vs; s <= s_last + opt_.landing_step_m + 1e-9; s += vs) {
     const Eigen::Vector2d q = o + s * axis->dir;
     bool seen = false, wall = false;
@@ -435,7 +443,10 @@ bool LocalPlanner::climb_on(const LocalPlanInput& in, LocalPlanResult& out, bool
       seen |= oc == map::Occupancy::kFree;
     }
     if (wall) break;
-    if (!seen) return false;
+    if (!seen) {
+      unseen = true;
+      break;
+    }
     for (double h = z - step - vs; h >= z - 1.0; h -= vs)
       if (view.occupancy(Eigen::Vector3f(float(q.x()), float(q.y()), float(h))) ==
           map::Occupancy::kOccupied)
@@ -455,6 +466,14 @@ bool LocalPlanner::climb_on(const LocalPlanInput& in, LocalPlanResult& out, bool
       if (ds > 0 && ds <= 0.2 + 1e-6) p.z() = std::max(p.z(), q.z());
     }
   }
+  // Nothing seen past the last support (the treads above it unseen yet): a partial climb up to
+  // it, at least two steps up; climbing goes on from there (below_climbed_landing).
+  climb_partial_ = unseen && pts.size() == n_flight;
+  const double yaw = std::atan2(axis->dir.y(), axis->dir.x());
+  if (climb_partial_) {
+    if (z - foot.z() < 2 * step) return false;
+    return straight_walk(in, pts, yaw, out);
+  }
   // The longest walk the body fits (its front stops short of a wall), ending at least
   // min_landing_m past where the flight reached the landing's height.
   double s_reach = s_top;
@@ -463,7 +482,6 @@ bool LocalPlanner::climb_on(const LocalPlanInput& in, LocalPlanResult& out, bool
       s_reach = (p.head<2>() - o).dot(axis->dir);
       break;
     }
-  const double yaw = std::atan2(axis->dir.y(), axis->dir.x());
   for (int tries = 0;
        tries < 16 && pts.size() > 1 &&
        (pts.back().head<2>() - o).dot(axis->dir) >= s_reach + opt_.min_landing_m - 1e-6;
@@ -474,6 +492,9 @@ bool LocalPlanner::climb_on(const LocalPlanInput& in, LocalPlanResult& out, bool
 
 bool LocalPlanner::below_climbed_landing(const Eigen::Vector3d& foot) const {
   for (const ClimbedFlight& f : climbed_) {
+    if (f.partial && (f.end_m.cast<double>() - foot).head<2>().norm() < 0.5 &&
+        std::abs(foot.z() - f.end_m.z()) < robot_.step_height_m)
+      return true;  // where a partial climb ended
     if (foot.z() > f.top_z_m - robot_.step_height_m) continue;
     for (const Eigen::Vector3f& q : f.path_m)
       if ((q.cast<double>() - foot).head<2>().norm() < 0.5) return true;
@@ -689,14 +710,16 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     climbing_ = false;
     climb_deferrals_ = 0;
     climb_done_s_ = in.t_s;
-    const float top = float(current_.pose(current_.t_end()).foot_m.z());
-    ClimbedFlight f{{}, top};
+    const Eigen::Vector3f end = current_.pose(current_.t_end()).foot_m.cast<float>();
+    const float top = end.z();
+    ClimbedFlight f{{}, top, end, climb_partial_};
     for (double t = current_.t_start(); t <= current_.t_end(); t += 0.25) {
       const Eigen::Vector3f q = current_.pose(t).foot_m.cast<float>();
       if (q.z() < top - 0.05f) f.path_m.push_back(q);  // the flight, not the landing
     }
     climbed_.push_back(std::move(f));
-    // Dropped on the flight (a wall seen ahead): no node grows there; on up from here.
+    // Dropped on the flight (a wall seen ahead), or a partial climb: no node grows there; on up
+    // from here.
     if (below_climbed_landing(in.robot_foot_m) && try_climb(true))
       return commit_climb("climb on: the climb stopped on the flight, on up it");
   }

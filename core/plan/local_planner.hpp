@@ -281,7 +281,10 @@ class LocalPlanner {
   struct ClimbedFlight {
     std::vector<Eigen::Vector3f> path_m;
     float top_z_m;
+    Eigen::Vector3f end_m;  // where the climb's walk ended
+    bool partial;           // it ended at the last tread seen, mid-flight
   };
+  bool climb_partial_ = false;  // climb_on's last walk ends mid-flight (nothing seen past it)
   std::vector<ClimbedFlight> climbed_;
   std::vector<int32_t>
       approached_;  // clusters whose viewpoint was reached once (walk onto them next)

@@ -406,3 +406,66 @@ TEST(ReachableGraph, RootOffGraphIsANewNodeUnderTheFeet) {
     }
   }
 }
+
+namespace {
+// The corridor, graph grown over its whole length, then narrowed at x = 5 to an opening
+// opening_m wide (observed from the robot's side).
+struct NarrowedCorridor {
+  World w = corridor();
+  Harness h;
+  explicit NarrowedCorridor(const GraphOptions& o) : h(o, 3) {
+    const Vector3f foot(0, 0, 0);
+    for (float x : {0.f, 3.f, 7.f, 10.f, 12.f})
+      h.observe(w, Vector3f(x, 0, 0.55f), foot, 100000, 11 + int(x), 5.0f);
+  }
+  void narrow(float opening_m) {
+    w.add({5.0f, -1.0f, 0.0f}, {5.2f, -opening_m / 2, 2.5f});
+    w.add({5.0f, opening_m / 2, 0.0f}, {5.2f, 1.0f, 2.5f});
+    for (int r = 0; r < 3; ++r)
+      h.observe(w, Vector3f(3.5f, 0, 0.55f), h.foot, 100000, 40 + r, 5.0f);
+  }
+  int far(ElementState s) const {
+    int n = 0;
+    for (NodeId i = 0; i < h.graph.node_capacity(); ++i) {
+      const GraphNode& g = h.graph.node(i);
+      n += g.alive && g.p_m.x() > 5.3f && g.state == s;
+    }
+    return n;
+  }
+};
+}  // namespace
+
+// GraphOptions::keep_reachable_cut: narrowing the corridor to a 0.7 m opening removes the nodes
+// there (the graph is cut) but C_reach, grown over the map's voxels with R_col, still passes it.
+// The far part, every node still in C_reach, is kept and re-linked; without the option it is
+// pruned (Maze's ramp lost the ground floor's graph that way).
+TEST(ReachableGraph, ACutOfTheGraphButNotOfCReachKeepsTheFarPart) {
+  GraphOptions o;
+  o.keep_reachable_cut = true;
+  NarrowedCorridor s(o);
+  const int before = s.far(ElementState::kConfirmed);
+  ASSERT_GT(before, 15);
+  s.narrow(0.7f);
+  EXPECT_GE(s.far(ElementState::kConfirmed), before - 3);
+  // Kept, and linked to the robot again by expansion through the opening.
+  ASSERT_NE(s.h.graph.root(), kNoId);
+  EXPECT_EQ(bfs_tree(s.h.graph, s.h.graph.root()).size(), s.h.graph.node_count());
+
+  // Without the option the same cut (same seeds) prunes the far part, and it does not regrow.
+  NarrowedCorridor pruned{GraphOptions{}};
+  pruned.narrow(0.7f);
+  EXPECT_EQ(pruned.far(ElementState::kConfirmed) + pruned.far(ElementState::kTentative), 0);
+}
+
+// ... but a wall across the corridor cuts C_reach too: the far part goes, option or not.
+TEST(ReachableGraph, KeepReachableCutStillPrunesAClosedCorridor) {
+  GraphOptions o;
+  o.keep_reachable_cut = true;
+  GapScenario s(o);
+  s.h.observe(s.w, Vector3f(6, 0, 0.55f), Vector3f(0, 0, 0), 60000, 14, 4.0f);
+  ASSERT_GT(s.count(9.0f, 14.0f), 5);
+  s.w.add({5.0f, -1.0f, 0.0f}, {5.2f, 1.0f, 2.5f});
+  s.h.observe(s.w, Vector3f(4, 0, 0.55f), Vector3f(0, 0, 0), 60000, 31, 4.0f);
+  EXPECT_EQ(s.count(5.2f, 15.0f), 0) << "cut-off component survived";
+  EXPECT_GT(s.count(-2.0f, 4.5f), 8);
+}

@@ -89,6 +89,45 @@ TEST(BsplineTrajectory, LimitsAndEndpointsOnRandomPolylines) {
   }
 }
 
+// One knot interval for the whole curve must not hold it far below the limits: a straight walk
+// reaches v_max (the halfway points next to the rest triples; it peaked at 0.71 v_max), a half
+// turn in place reaches most of the yaw-rate limit (it turned at 0.35 of it) and a turn on the
+// way does not slow the walk after it.
+TEST(BsplineTrajectory, StraightWalksAndTurnsInPlaceUseTheLimits) {
+  map::TraversabilityMap empty;
+  RobotModel robot;
+  CollisionChecker cc(robot, 0.1);
+  TrajectoryBuilder tb(robot);
+  auto peak = [](const BsplineTrajectory& t) {
+    double v = 0, w = 0;
+    for (double s = t.t_start(); s <= t.t_end(); s += 0.005) {
+      v = std::max(v, t.sample(s).v_mps.head<2>().norm());
+      w = std::max(w, std::abs(t.sample(s).yaw_rate_rps));
+    }
+    return std::pair{v, w};
+  };
+  const std::vector<Eigen::Vector3d> line{{0, 0, 0}, {6, 0, 0}};
+  const TrajectoryResult walk = tb.build(empty.view(), cc, line, 0.0, 0.0, 0.0);
+  ASSERT_EQ(walk.status, TrajectoryStatus::kOk);
+  expect_limits(walk.trajectory, robot);
+  EXPECT_GT(peak(walk.trajectory).first, 0.95 * robot.max_speed_mps);
+  // 6 m from rest to rest: no faster than v_max with the acceleration ramps, not much slower.
+  EXPECT_LT(walk.trajectory.duration(), 6.0 / robot.max_speed_mps + 3.0);
+
+  const std::vector<Eigen::Vector3d> here{{0, 0, 0}};
+  const TrajectoryResult turn = tb.build(empty.view(), cc, here, 0.0, M_PI, 0.0);
+  ASSERT_EQ(turn.status, TrajectoryStatus::kOk);
+  EXPECT_LE(peak(turn.trajectory).second, robot.max_yaw_rate_rps + 1e-9);
+  EXPECT_GT(peak(turn.trajectory).second, 0.8 * robot.max_yaw_rate_rps);
+  EXPECT_LT(turn.trajectory.duration(), 2.0 * M_PI / robot.max_yaw_rate_rps);
+
+  // Facing away from the walk: the turn at the start, then the walk at v_max.
+  const TrajectoryResult back = tb.build(empty.view(), cc, line, M_PI, 0.0, 0.0);
+  ASSERT_EQ(back.status, TrajectoryStatus::kOk);
+  expect_limits(back.trajectory, robot);
+  EXPECT_GT(peak(back.trajectory).first, 0.95 * robot.max_speed_mps);
+}
+
 // Turning in place: the control points differ by a millimetre in x and a centimetre of surface
 // noise in z. The body's pitch stays level (it was atan(10 / 1) = 84 deg, which put the box into
 // the next stair riser in the look-ahead).

@@ -19,7 +19,7 @@ TEST(ExploreStair, AClimbStoppedOnTheFlightGoesOnUpAndTheRunEndsComplete) {
   o.progress = [](const std::string&) {};
   const SimRunResult r = run_exploration(o);
   const RunMetrics& m = r.metrics;
-  // Measured (seed 1, session 12): complete at 91.5 s, floors 0.796 / 0.867. Before: the climb
+  // Measured (seed 1, session 12): complete at 85.5 s, floors 0.858 / 0.811. Before: the climb
   // ended mid-flight (z ~ 1.5 m), no graph node grew there and the run ended complete at 71.0 s
   // with the upper floor at 0.058; with that fixed but the completion check counting the climbed
   // flight's frontiers, it ran to the 300 s limit.

@@ -285,3 +285,21 @@ TEST(SimWorld, ScansFollowTheMovingRobot) {
   // Sensor frame -> world at the point's time reproduces the world point.
   EXPECT_NEAR(w.robot_state().position.x(), 2.5 + 0.5 * 0.75 + 0.0625, 0.02);
 }
+
+// Walking time counts the steps the body moved faster than kWalkingSpeed: not turning on the
+// spot, not creeping, not pushing against a wall.
+TEST(SimRobot, WalkingTimeCountsOnlyRealProgress) {
+  const sim::Scene s = sim::load_scene("test_table_room");
+  const sim::RayCaster rc(s.mesh);
+  sim::RobotModel robot(rc, {2.5, 3.0, 0.0, 0.0});
+  for (int i = 0; i < 100; ++i) robot.step(0.01, {0.0, 0, 0.8});  // turning on the spot
+  EXPECT_EQ(robot.state().walking_s, 0.0);
+  for (int i = 0; i < 100; ++i) robot.step(0.01, {0.1, 0, 0});  // creeping
+  EXPECT_EQ(robot.state().walking_s, 0.0);
+  sim::RobotModel walker(rc, {2.5, 1.2, 0.0, 0.0});  // facing the box at x 4..5
+  for (int i = 0; i < 400; ++i) walker.step(0.01, {0.5, 0, 0});
+  ASSERT_GE(walker.state().collisions, 1u);  // walked ~1.1 m, then pushed against the box
+  EXPECT_GT(walker.state().walking_s, 1.5);
+  EXPECT_LT(walker.state().walking_s, 3.5);
+  EXPECT_LE(walker.state().walking_s * 0.5, walker.state().distance + 0.05);
+}

@@ -91,6 +91,7 @@ std::string metrics_json(const RunMetrics& m) {
       m.success ? "true" : "false", m.floors_total, m.floors_explored);
   add("  \"exploration_time_s\": %.3f,\n  \"trajectory_length_m\": %.3f,\n", m.exploration_time_s,
       m.trajectory_length_m);
+  add("  \"walking_time_s\": %.3f,\n", m.walking_time_s);
   add("  \"traversable_volume_m3\": %.3f,\n  \"occupied_volume_m3\": %.3f,\n",
       m.traversable_volume_m3, m.occupied_volume_m3);
   add("  \"gt_traversable_volume_m3\": %.3f,\n  \"gt_occupied_volume_m3\": %.3f,\n",

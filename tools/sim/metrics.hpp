@@ -59,6 +59,7 @@ struct RunMetrics {
   bool completed = false;
   int floors_total = 0, floors_explored = 0;
   double exploration_time_s = 0.0, trajectory_length_m = 0.0;
+  double walking_time_s = 0.0;  // of exploration_time_s, moving at > kWalkingSpeed (0.2 m/s)
   double traversable_volume_m3 = 0.0, occupied_volume_m3 = 0.0;        // observed
   double gt_traversable_volume_m3 = 0.0, gt_occupied_volume_m3 = 0.0;  // ground truth
   double traversable_coverage = 0.0;

@@ -168,6 +168,7 @@ void RobotModel::physics_step(const VelocityCommand& cmd_in) {
     if (fell) ++s_.falls;
     const Eigen::Vector3d np(fx, fy, nz);
     s_.distance += (np - s_.position).norm();
+    if ((np - s_.position).head<2>().norm() > kWalkingSpeed * h) s_.walking_s += h;
     s_.position = np;
     s_.yaw = std::remainder(nyaw, 2.0 * M_PI);
     s_.pitch = pitch, s_.roll = roll;

@@ -39,6 +39,10 @@ struct VelocityCommand {
   double yaw_rate = 0.0;      // [rad/s]
 };
 
+// Planar speed above which the robot counts as walking (RobotState::walking_s): below it it
+// turns on the spot, waits for a plan, or creeps.
+inline constexpr double kWalkingSpeed = 0.2;  // [m/s]
+
 struct RobotState {
   double t = 0.0;                             // [s] virtual time
   Eigen::Vector3d position{0, 0, 0};          // [m] ground point under the body centre
@@ -49,7 +53,8 @@ struct RobotState {
   uint32_t collisions = 0;                    // events: body met the world (rising edges)
   uint32_t falls = 0;                         // events: support vanished beyond step height
   uint32_t stuck_events = 0;
-  double distance = 0.0;  // [m] path length travelled
+  double distance = 0.0;   // [m] path length travelled
+  double walking_s = 0.0;  // [s] time the body moved at more than kWalkingSpeed
   // world <- body: origin at `position`, rotated by yaw, pitch, roll.
   Eigen::Isometry3d body_pose() const;
 };

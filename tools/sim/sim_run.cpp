@@ -216,6 +216,10 @@ void write_record(const RecordInputs& in, std::vector<std::string>& written) {
   r << "| metric | value |\n|---|---|\n";
   r << "| exploration time | " << fmt("%.1f s", m.exploration_time_s) << " |\n";
   r << "| trajectory length | " << fmt("%.1f m", m.trajectory_length_m) << " |\n";
+  r << "| walking (> 0.2 m/s) | " << fmt("%.1f s", m.walking_time_s) << ", "
+    << fmt("%.0f %% of the time", 100 * m.walking_time_s / std::max(m.exploration_time_s, 1e-9))
+    << ", " << fmt("%.2f m/s", m.trajectory_length_m / std::max(m.walking_time_s, 1e-9))
+    << " while walking |\n";
   r << "| traversable coverage (ground truth) | " << fmt("%.1f %%", 100 * m.traversable_coverage)
     << " |\n";
   r << "| floors explored / total | " << m.floors_explored << " / " << m.floors_total << " |\n";
@@ -400,6 +404,7 @@ SimRunResult run_exploration(const SimRunOptions& opt) {
   const RobotState& rs = world.robot_state();
   m.exploration_time_s = t_end;
   m.trajectory_length_m = rs.distance;
+  m.walking_time_s = rs.walking_s;
   m.collisions = rs.collisions;
   m.falls = rs.falls;
   m.safety_stops = uint32_t(autonomy.safety_stops());
