@@ -2,11 +2,26 @@
 // Issue #9's bar for a whole exploration, shared by the integration tests: ended complete, every
 // one of the scene's floors explored (>= 90 % of its traversable ground truth), no collision or
 // fall.
+#include <cstdint>
+#include <string>
+
 #include <gtest/gtest.h>
 
 #include "tools/sim/sim_run.hpp"
 
 namespace storey::tools::sim {
+
+// A lockstep run of `scene` with the default configuration, no progress lines (coverage is still
+// sampled at the end).
+inline SimRunOptions quiet_run(const std::string& scene, uint32_t seed, double time_limit_s) {
+  SimRunOptions o;
+  o.scene = scene;
+  o.seed = seed;
+  o.time_limit_s = time_limit_s;
+  o.progress_period_s = 0;
+  o.progress = [](const std::string&) {};
+  return o;
+}
 
 inline void expect_every_floor_explored_safely(const SimRunResult& r, int floors) {
   const RunMetrics& m = r.metrics;

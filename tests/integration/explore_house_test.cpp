@@ -16,13 +16,7 @@ namespace storey::tools::sim {
 namespace {
 
 SimRunOptions house_options(double time_limit_s) {
-  SimRunOptions o;
-  o.scene = "house";
-  o.seed = 1;
-  o.time_limit_s = time_limit_s;
-  o.progress_period_s = 0;  // no progress lines; coverage still sampled at the end
-  o.progress = [](const std::string&) {};
-  return o;
+  return quiet_run("house", 1, time_limit_s);
 }
 
 // Issue #9's bar: both floors of the house explored (the robot walks up the flight past the

@@ -2,19 +2,14 @@
 // from floor 0 to floor 1 between side walls) explored in lockstep (stairs: explore_house_test).
 #include <gtest/gtest.h>
 
+#include "tests/integration/expectations.hpp"
 #include "tools/sim/sim_run.hpp"
 
 namespace storey::tools::sim {
 namespace {
 
 TEST(ExploreRamp, ReachesAndExploresTheUpperFloorSafely) {
-  SimRunOptions o;
-  o.scene = "test_ramp";
-  o.seed = 1;
-  o.time_limit_s = 600;
-  o.progress_period_s = 0;
-  o.progress = [](const std::string&) {};
-  const SimRunResult r = run_exploration(o);
+  const SimRunResult r = run_exploration(quiet_run("test_ramp", 1, 600));
   const RunMetrics& m = r.metrics;
   EXPECT_EQ(m.collisions, 0u);
   EXPECT_EQ(m.falls, 0u);

@@ -5,19 +5,14 @@
 // firmware's completion check, as it is out of the planner's targets.
 #include <gtest/gtest.h>
 
+#include "tests/integration/expectations.hpp"
 #include "tools/sim/sim_run.hpp"
 
 namespace storey::tools::sim {
 namespace {
 
 TEST(ExploreStair, AClimbStoppedOnTheFlightGoesOnUpAndTheRunEndsComplete) {
-  SimRunOptions o;
-  o.scene = "test_stair";
-  o.seed = 1;
-  o.time_limit_s = 300;
-  o.progress_period_s = 0;
-  o.progress = [](const std::string&) {};
-  const SimRunResult r = run_exploration(o);
+  const SimRunResult r = run_exploration(quiet_run("test_stair", 1, 300));
   const RunMetrics& m = r.metrics;
   // Measured (seed 1, session 12): complete at 85.5 s, floors 0.858 / 0.811. Before: the climb
   // ended mid-flight (z ~ 1.5 m), no graph node grew there and the run ended complete at 71.0 s
