@@ -154,15 +154,26 @@ BsplineTrajectory TrajectoryBuilder::fit(std::span<const Eigen::Vector3d> wp,
   const double wmax = std::max(robot_.max_yaw_rate_rps, 1e-3);
   const double amax = std::max(robot_.max_accel_mps2, 1e-3);
   const double wamax = std::max(robot_.max_yaw_accel_rps2, 1e-3);
+  // Control points a and b of c coincide (a point at rest); false out of range.
+  auto at_rest = [&](int a, int b) {
+    return a >= 0 && b < int(c.size()) && (c[size_t(a)] - c[size_t(b)]).norm() < 1e-9;
+  };
+  // The knot interval the travel needs (speed and acceleration bounds of the positions).
+  auto travel_dt = [&]() {
+    double dt = 1e-3;
+    for (size_t q = 0; q + 1 < c.size(); ++q)
+      dt = std::max(dt, (c[q + 1] - c[q]).head<2>().norm() / vmax);
+    for (size_t q = 0; q + 2 < c.size(); ++q)
+      dt = std::max(dt, std::sqrt((c[q + 2] - 2 * c[q + 1] + c[q]).head<2>().norm() / amax));
+    return dt;
+  };
   {
-    auto same = [&](int a, int b) { return (c[size_t(a)] - c[size_t(b)]).norm() < 1e-9; };
     std::vector<Eigen::Vector3d> c1;
     std::vector<double> y1;
     for (int q = 0; q < n; ++q) {
-      if (q > 0 && !same(q - 1, q) &&
-          ((q >= 2 && same(q - 2, q - 1)) || (q + 1 < n && same(q, q + 1)))) {
+      if (q > 0 && !at_rest(q - 1, q) && (at_rest(q - 2, q - 1) || at_rest(q, q + 1))) {
         c1.push_back(0.5 * (c[size_t(q - 1)] + c[size_t(q)]));
-        y1.push_back(same(q - 2, q - 1) ? y[size_t(q)] : y[size_t(q - 1)]);  // the travel's yaw
+        y1.push_back(at_rest(q - 2, q - 1) ? y[size_t(q)] : y[size_t(q - 1)]);  // the travel's yaw
       }
       c1.push_back(c[size_t(q)]);
       y1.push_back(y[size_t(q)]);
@@ -177,13 +188,7 @@ BsplineTrajectory TrajectoryBuilder::fit(std::span<const Eigen::Vector3d> wp,
   // w_max / wa_max, where turning in place reaches w_max), less a tenth. It was half the rate
   // limit's share of the nominal spacing / v_max, and with the travel's 0.71 s interval the robot
   // turned at 0.35 rad/s: 60 % of the house's exploration time went to turning on the spot.
-  double dt_travel = 1e-3;
-  for (size_t q = 0; q + 1 < c.size(); ++q)
-    dt_travel = std::max(dt_travel, (c[q + 1] - c[q]).head<2>().norm() / vmax);
-  for (size_t q = 0; q + 2 < c.size(); ++q)
-    dt_travel =
-        std::max(dt_travel, std::sqrt((c[q + 2] - 2 * c[q + 1] + c[q]).head<2>().norm() / amax));
-  const double dt_ref = std::max(dt_travel, wmax / wamax);
+  const double dt_ref = std::max(travel_dt(), wmax / wamax);
   const double yaw_step = 0.9 * std::min(wmax * dt_ref, wamax * dt_ref * dt_ref);
   const int n1 = int(c.size());
   std::vector<Eigen::Vector3d> c2;
@@ -191,9 +196,6 @@ BsplineTrajectory TrajectoryBuilder::fit(std::span<const Eigen::Vector3d> wp,
   c2.reserve(c.size());
   y2.reserve(c.size());
   // A turn next to a point at rest is made there, in place (before leaving it, after arriving).
-  auto at_rest = [&](int a, int b) {
-    return a >= 0 && b < n1 && (c[size_t(a)] - c[size_t(b)]).norm() < 1e-9;
-  };
   for (int q = 0; q < n1; ++q) {
     if (q > 0) {
       const int k = int(std::ceil(std::abs(y[q] - y[q - 1]) / yaw_step - 1e-9));
@@ -217,15 +219,10 @@ BsplineTrajectory TrajectoryBuilder::fit(std::span<const Eigen::Vector3d> wp,
   const int nc = int(c.size());
 
   // One knot interval satisfying every limit through the convex-hull bounds.
-  double dt = 1e-3;
-  for (int q = 0; q + 1 < nc; ++q) {
-    dt = std::max(dt, (c[q + 1] - c[q]).head<2>().norm() / vmax);
-    dt = std::max(dt, std::abs(y[q + 1] - y[q]) / wmax);
-  }
-  for (int q = 0; q + 2 < nc; ++q) {
-    dt = std::max(dt, std::sqrt((c[q + 2] - 2 * c[q + 1] + c[q]).head<2>().norm() / amax));
+  double dt = travel_dt();
+  for (int q = 0; q + 1 < nc; ++q) dt = std::max(dt, std::abs(y[q + 1] - y[q]) / wmax);
+  for (int q = 0; q + 2 < nc; ++q)
     dt = std::max(dt, std::sqrt(std::abs(y[q + 2] - 2 * y[q + 1] + y[q]) / wamax));
-  }
   return BsplineTrajectory(std::move(c), std::move(y), dt * (1 + 1e-9), t0);
 }
 

@@ -391,10 +391,9 @@ bool LocalPlanner::climb_on(const LocalPlanInput& in, LocalPlanResult& out, bool
   const double vs = view.voxel_size_m(), step = robot_.step_height_m;
   const Eigen::Vector2d o =
       axis->origin + axis->dir * (foot.head<2>() - axis->origin).dot(axis->dir);
-  // On the flight: a tread lower behind the robot, or a blind climb's path below its landing
-  // (the treads walked over blind are not in the map).
-  // Behind: 0.3-0.6 m back, one or two treads lower (half a metre back was two treads down on
-  // the house's flight at some positions, and the robot stood on it with no climb found).
+  // On the flight: a blind climb's path below its landing (the treads walked over blind are not
+  // in the map), or a tread 0.3-0.6 m back, one or two treads lower (half a metre back alone was
+  // two treads down at some places on the house's flight, and the robot stood there unclimbed).
   if (on_flight_only && !below_climbed_landing(foot)) {
     bool lower = false;
     for (double d = 0.3; d <= 0.6 + 1e-9 && !lower; d += 0.15) {

@@ -216,10 +216,10 @@ void write_record(const RecordInputs& in, std::vector<std::string>& written) {
   r << "| metric | value |\n|---|---|\n";
   r << "| exploration time | " << fmt("%.1f s", m.exploration_time_s) << " |\n";
   r << "| trajectory length | " << fmt("%.1f m", m.trajectory_length_m) << " |\n";
-  r << "| walking (> 0.2 m/s) | " << fmt("%.1f s", m.walking_time_s) << ", "
+  r << fmt("| walking (> %.1f m/s) | ", kWalkingSpeed) << fmt("%.1f s", m.walking_time_s) << ", "
     << fmt("%.0f %% of the time", 100 * m.walking_time_s / std::max(m.exploration_time_s, 1e-9))
     << ", " << fmt("%.2f m/s", m.trajectory_length_m / std::max(m.walking_time_s, 1e-9))
-    << " while walking |\n";
+    << " path length per walking second |\n";
   r << "| traversable coverage (ground truth) | " << fmt("%.1f %%", 100 * m.traversable_coverage)
     << " |\n";
   r << "| floors explored / total | " << m.floors_explored << " / " << m.floors_total << " |\n";
