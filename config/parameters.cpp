@@ -171,6 +171,7 @@ void read_plan(SectionReader&& r, core::plan::PlanOptions& o) {
   r.get("climb_blind", o.climb_blind);
   r.get("target_momentum", o.target_momentum);
   r.get("path_retries", o.path_retries, Range{0, 10});
+  r.get("climb_axis_ahead_m", o.climb_axis_ahead_m, Range{0.0, 1.5});
   r.get("incremental_maintenance", o.incremental_maintenance);
 }
 
@@ -222,6 +223,8 @@ void read_safety(SectionReader&& r, SafetyConfig& o) {
   r.get("link_timeout_s", o.link_timeout_s, Range{0.01, 10.0});
   r.get("lookahead_s", o.lookahead_s, Range{0.1, 10.0});
   r.get("max_overruns", o.max_overruns, Range{1, 1000});
+  r.get("turn_on_reference", o.turn_on_reference);
+  r.get("lookahead_on_plan_grid", o.lookahead_on_plan_grid);
 }
 
 void read_link(SectionReader&& r, LinkConfig& o) {

@@ -75,6 +75,15 @@ struct SafetyConfig {
   double link_timeout_s = 0.25;     // no robot state over the link for longer -> stop
   double lookahead_s = 1.0;         // predicted collision within this horizon -> stop
   int max_overruns = 3;             // consecutive control-task budget overruns -> stop
+  // Session 13 switches, off (docs/RESULTS.md session 13): each fixes a failure it was measured
+  // on, and each moved which seeds end with a floor unreached.
+  // Turn only where the robot will come to rest on the reference (ControlLaw::on_reference): a
+  // robot overshooting a new trajectory's start turned its body into a door frame.
+  bool turn_on_reference = false;
+  // The look-ahead samples the poses of the planner's own check (check_on_grid) and asks for a
+  // replan on every new trajectory it finds colliding: sampled from tau, it failed a pose the
+  // planner passed, and the robot stood stopped on a kept trajectory for 400 s (house seed 6).
+  bool lookahead_on_plan_grid = false;
 };
 
 enum class LinkTransport { kDds, kUdp, kCan, kSim };

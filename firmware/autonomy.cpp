@@ -55,7 +55,8 @@ Autonomy::Autonomy(Platform& platform, const rt::Clock& clock, AutonomyOptions o
       rng_(opt_.seed),
       policy_(make_exploration_policy(opt_.method, opt_.params)),
       plan_q_(64),
-      law_(opt_.params.robot),
+      law_(opt_.params.robot,
+           ControlGains{.turn_on_reference = opt_.params.safety.turn_on_reference}),
       safety_(opt_.params.safety),
       lookahead_(opt_.params.robot, opt_.params.map.voxel_size_m),
       stop_q_(256) {
@@ -484,19 +485,25 @@ void Autonomy::control_step() {
 
   // FCL look-ahead over the next lookahead_s of the trajectory, on the latest map: re-checked
   // whenever the map or the trajectory changes (between changes the answer can only shift
-  // along the curve; the extra 0.2 s covers the 10 Hz map period).
+  // along the curve; the extra 0.2 s covers the 10 Hz map period). With
+  // safety.lookahead_on_plan_grid the poses are those of the planner's checks (check_on_grid), so
+  // both agree on the same map, and every new trajectory predicted to collide asks for a replan.
   const auto wv = world_.read();
   if (has_traj && wv.ptr &&
       (wv.version != ctl_checked_map_ || ctl_traj_version_ != ctl_checked_traj_)) {
+    const bool new_traj = ctl_traj_version_ != ctl_checked_traj_;
     ctl_checked_map_ = wv.version;
     ctl_checked_traj_ = ctl_traj_version_;
     const auto& t = ctl_traj_->trajectory;
     const double horizon =
         std::max(0.0, std::min(opt_.params.safety.lookahead_s + 0.2, tau_end - tau_));
     const core::map::MapView view = wv.ptr->map->view();
-    const core::plan::CollisionHit hit = lookahead_.check_ahead(
-        view, [&](double s) { return pose_on(t, s); }, tau_, horizon, 0.0);
-    if (hit.collides && !collision_predicted_)
+    const auto pose_at = [&](double s) { return pose_on(t, s); };
+    const bool on_grid = opt_.params.safety.lookahead_on_plan_grid;
+    const core::plan::CollisionHit hit =
+        on_grid ? lookahead_.check_on_grid(view, pose_at, t.t_start(), t.t_end(), tau_, horizon)
+                : lookahead_.check_ahead(view, pose_at, tau_, horizon, 0.0);
+    if (hit.collides && (!collision_predicted_ || (on_grid && new_traj)))
       replan_request_.store(true, std::memory_order_release);
     collision_predicted_ = hit.collides;
   } else if (!has_traj) {

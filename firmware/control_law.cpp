@@ -19,7 +19,8 @@ VelocityCommand ControlLaw::track(const core::plan::TrajectorySample& ref, const
   VelocityCommand cmd;
   cmd.vx_mps = c * wx + s * wy;  // rotate into the body frame
   cmd.vy_mps = -s * wx + c * wy;
-  cmd.yaw_rate_rps = ref.yaw_rate_rps + gains_.k_yaw * wrap_angle(ref.yaw_rad - pose.yaw_rad);
+  cmd.yaw_rate_rps = (gains_.turn_on_reference ? on_reference(ref, pose) : 1.0) *
+                     (ref.yaw_rate_rps + gains_.k_yaw * wrap_angle(ref.yaw_rad - pose.yaw_rad));
   return limit(cmd, prev, dt_s);
 }
 
@@ -49,6 +50,23 @@ VelocityCommand ControlLaw::limit(VelocityCommand cmd, const VelocityCommand& pr
   cmd.yaw_rate_rps =
       std::clamp(cmd.yaw_rate_rps, prev.yaw_rate_rps - dw_max, prev.yaw_rate_rps + dw_max);
   return cmd;
+}
+
+double ControlLaw::on_reference(const core::plan::TrajectorySample& ref,
+                                const PoseSample& pose) const {
+  const double g = std::clamp((0.3 - braking_gap(ref, pose)) / 0.15, 0.0, 1.0);
+  return std::isfinite(g) ? g : 0.0;
+}
+
+double ControlLaw::braking_gap(const core::plan::TrajectorySample& ref,
+                               const PoseSample& pose) const {
+  const double c = std::cos(pose.yaw_rad), s = std::sin(pose.yaw_rad);
+  const Eigen::Vector2d v(c * pose.vx_mps - s * pose.vy_mps, s * pose.vx_mps + c * pose.vy_mps);
+  const Eigen::Vector2d vr = ref.v_mps.head<2>();
+  const double two_a = 2.0 * std::max(robot_.max_accel_mps2, 1e-3);
+  return (Eigen::Vector2d(pose.x_m, pose.y_m) - ref.p_m.head<2>() +
+          (v * v.norm() - vr * vr.norm()) / two_a)
+      .norm();
 }
 
 }  // namespace storey::firmware

@@ -10,8 +10,9 @@
 namespace storey::firmware {
 
 struct ControlGains {
-  double k_position = 1.2;  // [1/s] position error -> world velocity correction
-  double k_yaw = 2.0;       // [1/s] yaw error -> yaw rate correction
+  double k_position = 1.2;         // [1/s] position error -> world velocity correction
+  double k_yaw = 2.0;              // [1/s] yaw error -> yaw rate correction
+  bool turn_on_reference = false;  // scale the yaw command by on_reference() (safety config)
 };
 
 class ControlLaw {
@@ -20,8 +21,19 @@ class ControlLaw {
       : robot_(robot), gains_(gains) {}
   // ref: the trajectory sample for now; pose: odometry; prev: the last command sent; dt_s: the
   // control period (bounds the change of the command by the acceleration limits).
+  // With ControlGains::turn_on_reference the yaw command is scaled by on_reference(): the robot
+  // turns only where it will come to rest on the reference.
   VelocityCommand track(const core::plan::TrajectorySample& ref, const PoseSample& pose,
                         const VelocityCommand& prev, double dt_s) const;
+  // 1 while the point where the robot would stop if it braked now is within 0.15 m of the
+  // reference's, falling to 0 at 0.3 m. A new trajectory starts at rest where the robot was when
+  // it was planned; a robot arriving at walking speed overshoots that start by up to
+  // v^2 / (2 a_max) (0.5 m at 1 m/s) before it is back, and turning the 0.7 m body there, off
+  // the poses FCL checked, swept it into a door frame (teaching_building seed 1, 842 s).
+  double on_reference(const core::plan::TrajectorySample& ref, const PoseSample& pose) const;
+  // Distance between the points where the robot and the reference would come to rest if both
+  // braked at a_max now [m]: 0 when the robot is on the reference at its speed.
+  double braking_gap(const core::plan::TrajectorySample& ref, const PoseSample& pose) const;
   // Clamps a command to speed / yaw-rate limits and rate-limits it against prev (exposed for
   // tests).
   VelocityCommand limit(VelocityCommand cmd, const VelocityCommand& prev, double dt_s) const;

@@ -379,14 +379,24 @@ bool LocalPlanner::climb_on(const LocalPlanInput& in, LocalPlanResult& out, bool
   const map::MapView& view = *in.view;
   const Eigen::Vector3d foot = in.robot_foot_m;
   // The flight the robot faces; at a frontier at a flight's foot (not yet on it) also one beside
-  // or behind it (the walk turns onto the axis).
+  // or behind it (the walk turns onto the axis), found from the foot or, at a frontier, from up to
+  // PlanOptions::climb_axis_ahead_m ahead on level ground.
   std::optional<FlightAxis> axis;
-  for (int k = 0; k < (on_flight_only ? 1 : 4) && !axis; ++k) {
-    const double yaw = in.robot_yaw_rad + k * M_PI / 2;
-    const Eigen::Vector2d face(std::cos(yaw), std::sin(yaw));
-    axis = flight_axis(view, foot, face, 1.0);
-    if (axis && axis->dir.dot(face) < std::cos(M_PI / 4)) axis.reset();
-  }
+  for (double ahead = 0.0;
+       ahead <= (on_flight_only ? 0.0 : plan_opt_.climb_axis_ahead_m) + 1e-9 && !axis; ahead += 0.3)
+    for (int k = 0; k < (on_flight_only ? 1 : 4) && !axis; ++k) {
+      const double yaw = in.robot_yaw_rad + k * M_PI / 2;
+      const Eigen::Vector2d face(std::cos(yaw), std::sin(yaw));
+      Eigen::Vector3d from = foot;
+      from.head<2>() += ahead * face;
+      if (ahead > 0) {  // level ground ahead, the same floor
+        const auto sp = view.support_surface_near(from.cast<float>(), 0.5 * robot_.step_height_m);
+        if (!sp || sp->state != map::TravState::kTraversable) continue;
+        from.z() = sp->height_m;
+      }
+      axis = flight_axis(view, from, face, 1.0);
+      if (axis && axis->dir.dot(face) < std::cos(M_PI / 4)) axis.reset();
+    }
   if (!axis) return false;
   const double vs = view.voxel_size_m(), step = robot_.step_height_m;
   const Eigen::Vector2d o =

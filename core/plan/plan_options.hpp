@@ -58,6 +58,11 @@ struct PlanOptions {
   // where it stood) are retried up to this many times, each after a move to a new vantage point. 0:
   // off.
   int path_retries = 0;
+  // Beyond the paper, off (session 13): at a frontier the blind climb also looks for the flight
+  // from up to this far ahead on level ground (flight_axis needs treads 0.6 and 0.9 m ahead; a
+  // viewpoint 0.83 m before the first riser ended the office, seed 2, unclimbed). 0: from the
+  // foot only. On, it moved which seeds end with a floor unreached (docs/RESULTS.md session 13).
+  double climb_axis_ahead_m = 0.0;
   bool incremental_maintenance = true;
 };
 

@@ -23,21 +23,62 @@ TEST(ControlLaw, ClampsSpeedYawRateAndAcceleration) {
   PoseSample pose;
   pose.stamp_s = 0;
   VelocityCommand prev;
-  // Far away target, large yaw error: the command saturates, but only by a*dt per period.
+  // Far away target moving at twice the speed limit: the speed saturates, but only by a*dt per
+  // period.
   const double dt = 0.02;
-  VelocityCommand c = law.track(ref_at(10, 0, 2, 0, 3.0), pose, prev, dt);
+  VelocityCommand c = law.track(ref_at(10, 0, 2, 0, 0.0), pose, prev, dt);
   EXPECT_NEAR(std::hypot(c.vx_mps, c.vy_mps), robot.max_accel_mps2 * dt, 1e-9);
-  EXPECT_NEAR(c.yaw_rate_rps, robot.max_yaw_accel_rps2 * dt, 1e-9);
   for (int i = 0; i < 500; ++i) {
-    const VelocityCommand n = law.track(ref_at(10, 0, 2, 0, 3.0), pose, c, dt);
+    const VelocityCommand n = law.track(ref_at(10, 0, 2, 0, 0.0), pose, c, dt);
     EXPECT_LE(std::hypot(n.vx_mps - c.vx_mps, n.vy_mps - c.vy_mps),
               robot.max_accel_mps2 * dt + 1e-9);
-    EXPECT_LE(std::abs(n.yaw_rate_rps - c.yaw_rate_rps), robot.max_yaw_accel_rps2 * dt + 1e-9);
     c = n;
   }
   EXPECT_NEAR(std::hypot(c.vx_mps, c.vy_mps), robot.max_speed_mps, 1e-9);
-  EXPECT_NEAR(c.yaw_rate_rps, robot.max_yaw_rate_rps, 1e-9);
   EXPECT_GT(c.vx_mps, 0.99);  // heading +x in the body frame (yaw 0)
+  // On the reference at rest, large yaw error: the yaw rate saturates, by yaw_acc*dt per period.
+  c = law.track(ref_at(0, 0, 0, 0, 3.0), pose, prev, dt);
+  EXPECT_NEAR(c.yaw_rate_rps, robot.max_yaw_accel_rps2 * dt, 1e-9);
+  for (int i = 0; i < 500; ++i) {
+    const VelocityCommand n = law.track(ref_at(0, 0, 0, 0, 3.0), pose, c, dt);
+    EXPECT_LE(std::abs(n.yaw_rate_rps - c.yaw_rate_rps), robot.max_yaw_accel_rps2 * dt + 1e-9);
+    c = n;
+  }
+  EXPECT_NEAR(c.yaw_rate_rps, robot.max_yaw_rate_rps, 1e-9);
+}
+
+// A new trajectory that starts at rest, turning in place, reaches a robot walking past its start
+// at 0.95 m/s (teaching_building seed 1, 842 s): the robot brakes and comes back before it turns.
+TEST(ControlLaw, TurnsOnlyWhereItWillComeToRestOnTheReference) {
+  core::RobotModel robot;
+  ControlLaw law(robot, ControlGains{.turn_on_reference = true});
+  const auto start = ref_at(0, 0, 0, 0, 1.5);  // the new trajectory's start: turn left in place
+  PoseSample pose;
+  pose.vx_mps = 0.95;  // walking +x past it
+  EXPECT_EQ(law.on_reference(start, pose), 0.0);
+  VelocityCommand prev;
+  prev.vx_mps = 0.95;
+  // Closed loop with a robot that does what it is told: no yaw until it is back on the start.
+  const double dt = 0.02;
+  double max_x = 0, yaw_when_far = 0;
+  for (int i = 0; i < 400; ++i) {
+    const VelocityCommand c = law.track(start, pose, prev, dt);
+    pose.x_m += dt * (std::cos(pose.yaw_rad) * c.vx_mps - std::sin(pose.yaw_rad) * c.vy_mps);
+    pose.y_m += dt * (std::sin(pose.yaw_rad) * c.vx_mps + std::cos(pose.yaw_rad) * c.vy_mps);
+    pose.yaw_rad += dt * c.yaw_rate_rps;
+    pose.vx_mps = c.vx_mps, pose.vy_mps = c.vy_mps, pose.yaw_rate_rps = c.yaw_rate_rps;
+    max_x = std::max(max_x, pose.x_m);
+    if (std::hypot(pose.x_m, pose.y_m) > 0.3) yaw_when_far = std::max(yaw_when_far, pose.yaw_rad);
+    prev = c;
+  }
+  EXPECT_GT(max_x, 0.4);                 // the overshoot is real (0.95^2 / 2 = 0.45 m)...
+  EXPECT_LT(yaw_when_far, 0.05);         // ...but the body does not turn out there
+  EXPECT_NEAR(pose.yaw_rad, 1.5, 0.05);  // it turns once back on the start
+  EXPECT_LT(std::hypot(pose.x_m, pose.y_m), 0.05);
+  // Tracking a moving reference closely (same braking point): full yaw authority.
+  PoseSample moving;
+  moving.vx_mps = 0.9;
+  EXPECT_EQ(law.on_reference(ref_at(0.05, 0, 0.9, 0, 0), moving), 1.0);
 }
 
 TEST(ControlLaw, FeedforwardInBodyFrameAndNanGuard) {
