@@ -40,6 +40,7 @@ TEST(Results, ReadsTheSimulatorsMetricsJson) {
   const std::string dir = test::fresh_dir("read");
   sim::RunMetrics m = test::fixture_metrics(530, 470, 271, 495);
   m.collisions = 1;
+  m.walking_time_s = 321.5;
   m.latency.push_back({"map", 1.0, 2.0, 3.0, 4});
   test::write_run(dir, m, "exploration complete at 530.0 s");
   std::string err;
@@ -53,6 +54,7 @@ TEST(Results, ReadsTheSimulatorsMetricsJson) {
   ASSERT_EQ(r->per_floor.size(), 2u);
   EXPECT_DOUBLE_EQ(r->per_floor[1].time_s, 495.0);
   EXPECT_DOUBLE_EQ(r->collisions, 1.0);
+  EXPECT_DOUBLE_EQ(r->walking_time_s, 321.5);
   ASSERT_EQ(r->coverage_over_time.size(), 3u);
   EXPECT_DOUBLE_EQ(r->coverage_over_time[1].first, 265.0);
   EXPECT_DOUBLE_EQ(floor_time(*r, 0), 271.0);
@@ -203,6 +205,7 @@ TEST(Results, CsvHasOneRowPerRunAndJsonParses) {
   ASSERT_EQ(lines.size(), 1u + fx.outcomes.size());
   EXPECT_EQ(lines[0].rfind("scene,method,ablation,seed,status,", 0), 0u);
   EXPECT_NE(lines[0].find(",floor2_time_s,floor2_coverage,"), std::string::npos);
+  EXPECT_NE(lines[0].find(",safety_stops,walking_time_s,reason,"), std::string::npos);
   EXPECT_EQ(lines[1].rfind("two,storey,full,1,finished,0,,0.0,1,2,2,500.000,400.000,", 0), 0u)
       << lines[1];
   EXPECT_EQ(lines[4].rfind("two,tare-like,full,1,failed,0,2,", 0), 0u) << lines[4];

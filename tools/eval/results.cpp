@@ -435,7 +435,7 @@ std::string results_csv(const std::vector<RunOutcome>& outcomes) {
        "floors_explored,exploration_time_s,trajectory_length_m,traversable_coverage,"
        "traversable_volume_m3,occupied_volume_m3,gt_traversable_volume_m3,gt_occupied_volume_m3";
   for (size_t f = 1; f <= nf; ++f) c << ",floor" << f << "_time_s,floor" << f << "_coverage";
-  c << ",collisions,falls,safety_stops,reason,run_dir\n";
+  c << ",collisions,falls,safety_stops,walking_time_s,reason,run_dir\n";
   for (const auto& o : outcomes) {
     const bool ok = o.status == RunStatus::finished;
     const MetricsRecord& m = o.metrics;
@@ -456,8 +456,9 @@ std::string results_csv(const std::vector<RunOutcome>& outcomes) {
         << (has ? fmt("%.4f", m.per_floor[f].traversable_coverage) : "");
     }
     c << "," << num(m.collisions, "%.0f") << "," << num(m.falls, "%.0f") << ","
-      << num(m.safety_stops, "%.0f") << "," << csv_field(o.reason) << ","
-      << csv_field(o.spec.rel_dir()) << "\n";
+      << num(m.safety_stops, "%.0f") << ","
+      << (ok && m.walking_time_s >= 0 ? fmt("%.3f", m.walking_time_s) : "") << ","
+      << csv_field(o.reason) << "," << csv_field(o.spec.rel_dir()) << "\n";
   }
   return c.str();
 }
@@ -486,7 +487,9 @@ std::string results_json(const ResultsInput& in) {
         << ", \"occupied_volume_m3\": " << json_number(m.occupied_volume_m3)
         << ", \"collisions\": " << json_number(m.collisions)
         << ", \"falls\": " << json_number(m.falls)
-        << ", \"safety_stops\": " << json_number(m.safety_stops) << ", \"per_floor\": [";
+        << ", \"safety_stops\": " << json_number(m.safety_stops) << ", \"walking_time_s\": "
+        << (m.walking_time_s >= 0 ? json_number(m.walking_time_s) : std::string("null"))
+        << ", \"per_floor\": [";
       for (size_t f = 0; f < m.per_floor.size(); ++f)
         j << (f ? ", " : "") << "{\"z_m\": " << json_number(m.per_floor[f].z_m)
           << ", \"time_s\": " << json_number(m.per_floor[f].time_s)
@@ -519,6 +522,9 @@ std::string results_json(const ResultsInput& in) {
       << stat_json(stat_over(g, [](auto& m) { return m.occupied_volume_m3; }))
       << ",\n     \"traversable_coverage\": "
       << stat_json(stat_over(g, [](auto& m) { return m.traversable_coverage; }))
+      << ", \"walking_time_s\": "
+      << stat_json(
+             stat_over(g, [](auto& m) { return m.walking_time_s >= 0 ? m.walking_time_s : kNaN; }))
       << ",\n     \"floor_time_s\": [";
     for (size_t f = 0; f < nf; ++f)
       j << (f ? ", " : "") << stat_json(stat_over(g, [f](auto& m) {

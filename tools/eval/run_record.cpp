@@ -76,6 +76,8 @@ std::optional<MetricsRecord> read_metrics_json(const std::string& path, std::str
       return fail("coverage_over_time entry is not [t, coverage]");
     m.coverage_over_time.emplace_back(p.array()[0].number(), p.array()[1].number());
   }
+  if (const JsonValue* w = j.find("walking_time_s"); w && w->is_number())
+    m.walking_time_s = w->number();
   // Not written by tools/sim today; read when a later metrics.json carries it.
   if (const JsonValue* r = j.find("end_reason"); r && r->is_string()) m.end_reason = r->string();
   return m;

@@ -27,6 +27,9 @@ struct MetricsRecord {
   double traversable_coverage = 0.0;
   std::vector<FloorRecord> per_floor;
   double collisions = 0, falls = 0, safety_stops = 0;
+  // Time moving faster than 0.2 m/s (tools/sim kWalkingSpeed); < 0: not in the record (a
+  // metrics.json from before session 12).
+  double walking_time_s = -1.0;
   std::vector<std::pair<double, double>> coverage_over_time;  // (t [s], coverage 0..1)
   std::string end_reason;                                     // "" when not recorded
 };
