@@ -31,15 +31,16 @@ class ControlLaw {
   // v^2 / (2 a_max) (0.5 m at 1 m/s) before it is back, and turning the 0.7 m body there, off
   // the poses FCL checked, swept it into a door frame (teaching_building seed 1, 842 s).
   double on_reference(const core::plan::TrajectorySample& ref, const PoseSample& pose) const;
-  // Distance between the points where the robot and the reference would come to rest if both
-  // braked at a_max now [m]: 0 when the robot is on the reference at its speed.
-  double braking_gap(const core::plan::TrajectorySample& ref, const PoseSample& pose) const;
   // Clamps a command to speed / yaw-rate limits and rate-limits it against prev (exposed for
   // tests).
   VelocityCommand limit(VelocityCommand cmd, const VelocityCommand& prev, double dt_s) const;
   const core::RobotModel& robot() const { return robot_; }
 
  private:
+  // Distance between the points where the robot and the reference would come to rest if both
+  // braked at a_max now [m]: 0 when the robot is on the reference at its speed.
+  double braking_gap(const core::plan::TrajectorySample& ref, const PoseSample& pose) const;
+
   core::RobotModel robot_;
   ControlGains gains_;
 };

@@ -457,7 +457,7 @@ std::string results_csv(const std::vector<RunOutcome>& outcomes) {
     }
     c << "," << num(m.collisions, "%.0f") << "," << num(m.falls, "%.0f") << ","
       << num(m.safety_stops, "%.0f") << ","
-      << (ok && m.walking_time_s >= 0 ? fmt("%.3f", m.walking_time_s) : "") << ","
+      << (ok && std::isfinite(m.walking_time_s) ? fmt("%.3f", m.walking_time_s) : "") << ","
       << csv_field(o.reason) << "," << csv_field(o.spec.rel_dir()) << "\n";
   }
   return c.str();
@@ -487,9 +487,8 @@ std::string results_json(const ResultsInput& in) {
         << ", \"occupied_volume_m3\": " << json_number(m.occupied_volume_m3)
         << ", \"collisions\": " << json_number(m.collisions)
         << ", \"falls\": " << json_number(m.falls)
-        << ", \"safety_stops\": " << json_number(m.safety_stops) << ", \"walking_time_s\": "
-        << (m.walking_time_s >= 0 ? json_number(m.walking_time_s) : std::string("null"))
-        << ", \"per_floor\": [";
+        << ", \"safety_stops\": " << json_number(m.safety_stops)
+        << ", \"walking_time_s\": " << json_number(m.walking_time_s) << ", \"per_floor\": [";
       for (size_t f = 0; f < m.per_floor.size(); ++f)
         j << (f ? ", " : "") << "{\"z_m\": " << json_number(m.per_floor[f].z_m)
           << ", \"time_s\": " << json_number(m.per_floor[f].time_s)
@@ -523,8 +522,7 @@ std::string results_json(const ResultsInput& in) {
       << ",\n     \"traversable_coverage\": "
       << stat_json(stat_over(g, [](auto& m) { return m.traversable_coverage; }))
       << ", \"walking_time_s\": "
-      << stat_json(
-             stat_over(g, [](auto& m) { return m.walking_time_s >= 0 ? m.walking_time_s : kNaN; }))
+      << stat_json(stat_over(g, [](auto& m) { return m.walking_time_s; }))
       << ",\n     \"floor_time_s\": [";
     for (size_t f = 0; f < nf; ++f)
       j << (f ? ", " : "") << stat_json(stat_over(g, [f](auto& m) {

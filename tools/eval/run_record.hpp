@@ -3,6 +3,7 @@
 // own eval.json (exit status, failure reason, wall time).
 #pragma once
 
+#include <cmath>
 #include <optional>
 #include <string>
 #include <utility>
@@ -27,9 +28,9 @@ struct MetricsRecord {
   double traversable_coverage = 0.0;
   std::vector<FloorRecord> per_floor;
   double collisions = 0, falls = 0, safety_stops = 0;
-  // Time moving faster than 0.2 m/s (tools/sim kWalkingSpeed); < 0: not in the record (a
-  // metrics.json from before session 12).
-  double walking_time_s = -1.0;
+  // Time moving faster than 0.2 m/s (tools/sim kWalkingSpeed); NaN: not in the record (a
+  // metrics.json from before session 12; null in results.json, skipped by the statistics).
+  double walking_time_s = std::nan("");
   std::vector<std::pair<double, double>> coverage_over_time;  // (t [s], coverage 0..1)
   std::string end_reason;                                     // "" when not recorded
 };
