@@ -33,6 +33,7 @@
 #include "core/plan/collision_checker.hpp"
 #include "core/plan/escape.hpp"
 #include "core/plan/graph_search.hpp"
+#include "core/plan/path_centring.hpp"
 #include "core/plan/plan_options.hpp"
 #include "core/plan/stage_probe.hpp"
 #include "core/plan/tsp.hpp"
@@ -137,6 +138,11 @@ struct LocalPlannerOptions {
   // clusters, set aside at their viewpoints, came back whenever the map near them changed (the
   // office, seed 2: deferred at least 4 times in 600 s, the upper floor never reached).
   int max_climb_deferrals = 2;
+  // With PlanOptions::flight_foot a deferral counts only with at most this many other clusters.
+  int climb_deferral_max_others = 2;
+  // With PlanOptions::flight_foot: cycles without a way back to a climb left for last before it
+  // is given up (one B-spline failure gave up house seed 7's flight, session 14; else 1).
+  int max_climb_return_failures = 6;
   double keep_target_margin_m = 2.0;     // periodic replan: the current target stays first
   double keep_target_margin_frac = 0.1;  // unless another tour is shorter by max(m, frac * tour)
   double set_aside_expiry_s = 30.0;      // a set-aside node may expire after this [s] ...
@@ -210,12 +216,20 @@ class LocalPlanner {
               const Eigen::Vector3f* away_from = nullptr);
   bool try_target(const LocalPlanInput& in, const Viewpoint& vp, LocalPlanResult& out,
                   SetAsideReason* why);
-  // A cluster other than except_id with a frontier node not set aside.
-  bool other_targets(const LocalPlanInput& in, int32_t except_id) const;
+  // Clusters other than except_id with a frontier node not set aside.
+  int other_targets(const LocalPlanInput& in, int32_t except_id) const;
   // Facing up a flight: straight up the flight's axis to the last support seen and
   // landing_step_m beyond (see local_planner.cpp). on_flight_only: only if the robot stands on
   // the flight already (a lower tread behind it).
-  bool climb_on(const LocalPlanInput& in, LocalPlanResult& out, bool on_flight_only);
+  // given: the flight from to_flight_foot (the robot stands at its foot).
+  bool climb_on(const LocalPlanInput& in, LocalPlanResult& out, bool on_flight_only,
+                const FlightFoot* given = nullptr);
+  // PlanOptions::flight_foot: cluster c, about to be set aside, has a flight's first riser near:
+  // a new target at the flight's foot (flight_foot()), once per foot; false if none.
+  bool to_flight_foot(const LocalPlanInput& in, const graph::FrontierCluster& c,
+                      LocalPlanResult& out);
+  // Stage 3 to f's stand point, else up to 0.75 m farther back on the axis (room to turn).
+  bool to_foot_of(const LocalPlanInput& in, const FlightFoot& f, LocalPlanResult& out);
   // A straight walk at constant yaw through `pts` (foot points), checked against the map.
   bool straight_walk(const LocalPlanInput& in, const std::vector<Eigen::Vector3d>& pts, double yaw,
                      LocalPlanResult& out);
@@ -269,6 +283,8 @@ class LocalPlanner {
   struct DeferredClimb {
     Eigen::Vector3d foot_m;
     double yaw_rad;
+    std::optional<FlightFoot> flight;  // found by to_flight_foot: climbed from its foot
+    int failures = 0;                  // cycles in which no way back to it was found
   };
   std::optional<DeferredClimb> deferred_climb_;
   int climb_deferrals_ = 0;  // climbs deferred since the last climb
@@ -287,7 +303,10 @@ class LocalPlanner {
   bool climb_partial_ = false;  // climb_on's last walk ends mid-flight (nothing seen past it)
   std::vector<ClimbedFlight> climbed_;
   std::vector<int32_t>
-      approached_;  // clusters whose viewpoint was reached once (walk onto them next)
+      approached_;              // clusters whose viewpoint was reached once (walk onto them next)
+  bool flight_target_ = false;  // the target is a flight's foot (to_flight_foot) ...
+  FlightFoot flight_foot_;      // ... this one
+  std::vector<Eigen::Vector3f> flight_feet_tried_;  // each foot is a target once
 };
 
 }  // namespace storey::core::plan

@@ -229,6 +229,125 @@ std::optional<FlightAxis> flight_axis(const map::MapView& view, const Eigen::Vec
   return a;
 }
 
+std::optional<FlightFoot> flight_foot(const map::MapView& view,
+                                      const std::vector<Eigen::Vector3d>& near, double floor_z,
+                                      double back_m, double radius_m, double run_up_m) {
+  if (near.empty() || !std::isfinite(floor_z)) return std::nullopt;
+  const RobotModel& r = view.robot();
+  const double s = view.voxel_size_m(), step = r.step_height_m;
+  const auto height_at = [&](const Eigen::Vector2d& q, double z, double window) {
+    const auto sp =
+        view.support_surface_near(Eigen::Vector3f(float(q.x()), float(q.y()), float(z)), window);
+    return sp ? double(sp->height_m) : NAN;
+  };
+  // The first riser's points: columns holding the first tread (a step above the floor) with the
+  // floor behind them and a higher tread ahead, in one of 8 directions. (The map's step edges,
+  // VoxelStats::kStepEdge, mark few of a riser's voxels seen from the floor; the floor just before
+  // a flight is often unseen: the LiDAR's blind ring around the robot at its viewpoint.)
+  struct Edge {
+    Eigen::Vector2d p, n;
+    double d;
+  };
+  std::vector<Edge> edges;
+  Eigen::Vector2d lo = near.front().head<2>(), hi = lo;
+  for (const Eigen::Vector3d& q : near) {
+    lo = lo.cwiseMin(q.head<2>());
+    hi = hi.cwiseMax(q.head<2>());
+  }
+  const auto cell = [&](double v) { return int32_t(std::floor(v / s)); };
+  for (int32_t kx = cell(lo.x() - radius_m); kx <= cell(hi.x() + radius_m); ++kx)
+    for (int32_t ky = cell(lo.y() - radius_m); ky <= cell(hi.y() + radius_m); ++ky) {
+      const Eigen::Vector2d q((kx + 0.5) * s, (ky + 0.5) * s);
+      double d = INFINITY;
+      for (const Eigen::Vector3d& p : near) d = std::min(d, (p.head<2>() - q).norm());
+      if (d > radius_m) continue;
+      const double t1 = height_at(q, floor_z + 0.9 * step, 0.45 * step);
+      if (!(t1 > floor_z + 0.5 * step)) continue;
+      for (int k = 0; k < 8; ++k) {
+        const Eigen::Vector2d u(std::cos(k * M_PI / 4), std::sin(k * M_PI / 4));
+        bool ground = false, t2 = false;
+        for (double b = 0.15; b <= 0.8 + 1e-9 && !ground; b += 0.1)
+          ground = std::abs(height_at(q - b * u, floor_z, 0.5 * step) - floor_z) < 0.5 * step;
+        for (double a = 0.2; a <= 0.45 + 1e-9 && !t2 && ground; a += 0.1)
+          t2 = height_at(q + a * u, t1 + 0.9 * step, 0.45 * step) > t1 + 0.5 * step;
+        if (!t2) continue;
+        edges.push_back({q - 0.5 * s * u, u, d});
+      }
+    }
+  if (edges.empty()) return std::nullopt;
+  // The riser line: the points facing one way within 0.2 m across and 1.5 m along a line
+  // through one of them, the line with the most (ties: nearest the cluster).
+  const auto line_of = [&](const Edge& e0, std::vector<Eigen::Vector2d>* pts) {
+    const Eigen::Vector2d t0(-e0.n.y(), e0.n.x());
+    int n = 0;
+    for (const Edge& e : edges) {
+      const Eigen::Vector2d dp = e.p - e0.p;
+      if (e.n.dot(e0.n) < 0.99 || std::abs(dp.dot(e0.n)) > 0.2 || std::abs(dp.dot(t0)) > 1.5)
+        continue;
+      if (pts) pts->push_back(e.p);
+      ++n;
+    }
+    return n;
+  };
+  const Edge* best = nullptr;
+  int best_n = 0;
+  for (const Edge& e : edges) {
+    const int n = line_of(e, nullptr);
+    if (n > best_n || (n == best_n && e.d < best->d)) best = &e, best_n = n;
+  }
+  std::vector<Eigen::Vector2d> line;
+  if (line_of(*best, &line) < 3) return std::nullopt;
+  // The riser's direction from its points (principal axis; the 8 search directions are 45 deg
+  // apart) and its middle.
+  Eigen::Vector2d c = Eigen::Vector2d::Zero();
+  for (const Eigen::Vector2d& p : line) c += p;
+  c /= double(line.size());
+  double sxx = 0, sxy = 0, syy = 0;
+  for (const Eigen::Vector2d& p : line) {
+    const Eigen::Vector2d d = p - c;
+    sxx += d.x() * d.x(), sxy += d.x() * d.y(), syy += d.y() * d.y();
+  }
+  const double th = 0.5 * std::atan2(2.0 * sxy, sxx - syy);  // the riser's own direction
+  Eigen::Vector2d up(-std::sin(th), std::cos(th));
+  if (up.dot(best->n) < 0) up = -up;
+  if (up.dot(best->n) < std::cos(M_PI / 4)) return std::nullopt;  // not a line across the search
+  // The axis: up the riser's normal through its middle, moved sideways to the middle between the
+  // side walls as flight_axis finds them where it agrees on the direction (it reads the direction
+  // from tread heights, biased toward the better-seen side of a flight).
+  const Eigen::Vector2d f2 = c - back_m * up;
+  const double fz = height_at(f2, floor_z, 0.5 * step);
+  const auto found = flight_axis(view, {f2.x(), f2.y(), std::isfinite(fz) ? fz : floor_z}, up, 1.0);
+  if (!found) return std::nullopt;  // no rise along it: not a flight
+  FlightAxis a;
+  a.dir = up;
+  a.origin = c;
+  if (found->dir.dot(up) >= std::cos(15 * M_PI / 180)) {
+    const Eigen::Vector2d nrm(-up.y(), up.x());
+    a.origin += (found->origin - c).dot(nrm) * nrm;
+    a.width_m = found->width_m;
+  }
+  const std::optional<FlightAxis> axis = a;
+  // Where to stand: the point on the axis nearest the riser, at least back_m before it, on floor
+  // the robot can walk to (in C_reach).
+  const double t_riser = (c - axis->origin).dot(axis->dir);
+  std::optional<map::SurfacePoint> sp;
+  Eigen::Vector2d foot2;
+  for (double b = back_m; b <= back_m + run_up_m + 1e-9 && !sp; b += 0.5 * s) {
+    foot2 = axis->origin + (t_riser - b) * axis->dir;
+    sp = view.support_surface_near(
+        Eigen::Vector3f(float(foot2.x()), float(foot2.y()), float(floor_z)), 0.5 * step);
+    if (sp && !sp->reachable) sp.reset();  // Stage 3's voxel A* walks C_reach
+  }
+  if (!sp) return std::nullopt;
+  FlightFoot out;
+  out.foot_m = {foot2.x(), foot2.y(), double(sp->height_m)};
+  out.to_riser_m = t_riser - (foot2 - axis->origin).dot(axis->dir);
+  out.yaw_rad = std::atan2(axis->dir.y(), axis->dir.x());
+  out.axis = *axis;
+  out.riser_m = {c.x(), c.y(), floor_z};
+  return out;
+}
+
 FlightShaping shape_flights(const map::MapView& view, std::vector<Eigen::Vector3d>& points) {
   FlightShaping out;
   const RobotModel& r = view.robot();

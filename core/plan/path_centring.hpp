@@ -45,6 +45,26 @@ struct FlightAxis {
 std::optional<FlightAxis> flight_axis(const map::MapView& view, const Eigen::Vector3d& foot,
                                       const Eigen::Vector2d& hint, double sign);
 
+// Where to stand to climb a flight seen from its foot: on its axis, facing up, `back_m` before
+// its first riser (or up to run_up_m farther back, where the floor is walkable: the floor just
+// before a flight is often unseen), on the level of `floor_z`. The first riser is found from the
+// support heights (the first tread a step above floor_z, the floor behind it, a higher tread
+// ahead) nearest to one of `near` (a frontier cluster's nodes) within `radius_m`; the axis then
+// comes from flight_axis (centred between the side walls). A climb from a frontier's own
+// viewpoint fails when it stands 0.8 m or more before the first riser (flight_axis needs treads
+// 0.6 and 0.9 m ahead) or off the axis; an A* path onto the first tread meets it diagonally.
+struct FlightFoot {
+  Eigen::Vector3d foot_m = Eigen::Vector3d::Zero();  // support point to stand on
+  double yaw_rad = 0;                                // up the axis
+  FlightAxis axis;
+  Eigen::Vector3d riser_m = Eigen::Vector3d::Zero();  // middle of the first riser, at the floor
+  double to_riser_m = 0;                              // from foot_m along the axis
+};
+std::optional<FlightFoot> flight_foot(const map::MapView& view,
+                                      const std::vector<Eigen::Vector3d>& near, double floor_z,
+                                      double back_m = 0.45, double radius_m = 1.5,
+                                      double run_up_m = 1.0);
+
 struct FlightShaping {
   int flights = 0;                 // flights re-laid on their axis
   int no_axis = 0, no_run_up = 0;  // flights left as they were, and why

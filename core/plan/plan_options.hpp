@@ -63,6 +63,12 @@ struct PlanOptions {
   // viewpoint 0.83 m before the first riser ended the office, seed 2, unclimbed). 0: from the
   // foot only. On, it moved which seeds end with a floor unreached (docs/RESULTS.md session 13).
   double climb_axis_ahead_m = 0.0;
+  // Beyond the paper (session 14, with climb_blind): a frontier cluster about to be set aside (its
+  // viewpoint reached and still a frontier, or Stage 3 failing) with a flight's first riser within
+  // 1.5 m is first approached at the flight's foot (flight_foot: on its axis, facing up, 0.45 m
+  // before the riser), where the blind climb can start; the stair-foot "complete" of house seeds
+  // 6 and 7 (docs/RESULTS.md session 13).
+  bool flight_foot = false;
   bool incremental_maintenance = true;
 };
 

@@ -135,6 +135,33 @@ TEST(PathCentring, FlightIsWalkedOnItsAxisAfterARunUp) {
   EXPECT_EQ(level.size(), 3u);
 }
 
+// The place to climb from, found from a frontier cluster's nodes beside the flight's foot (one
+// off to the side, one at the corner): on the axis (y = 0), facing up (+x), 0.45 m before the
+// first riser (x = 0), on the floor. Where no flight is near, none.
+TEST(PathCentring, FlightFootStandsOnTheAxisBeforeTheFirstRiser) {
+  map::TraversabilityMap m;
+  storey::test::scan_world(m, stair_world(), {{-1.5f, 1.0f, 0.5f}, {-1.0f, -1.5f, 0.5f}});
+  const map::MapView view = m.view();
+  const std::vector<Vector3d> near = {{-0.3, 1.1, 0.0}, {-0.6, -0.9, 0.0}};
+  const auto f = flight_foot(view, near, 0.0);
+  ASSERT_TRUE(f.has_value());
+  EXPECT_NEAR(f->riser_m.x(), 0.0, 0.1) << f->riser_m.transpose();
+  EXPECT_NEAR(f->foot_m.x(), -0.45, 0.1) << f->foot_m.transpose();
+  EXPECT_NEAR(f->foot_m.y(), 0.0, 0.12) << f->foot_m.transpose();
+  EXPECT_NEAR(f->foot_m.z(), 0.0, 0.05);
+  EXPECT_NEAR(f->yaw_rad, 0.0, 0.15);
+  // Farther back on request; nothing from points out of reach of the flight or a step too high.
+  const auto g = flight_foot(view, near, 0.0, 0.7);
+  ASSERT_TRUE(g.has_value());
+  EXPECT_NEAR(g->foot_m.x(), -0.7, 0.1);
+  EXPECT_FALSE(flight_foot(view, {{-3.0, -2.5, 0.0}}, 0.0, 0.45, 1.0).has_value());
+  EXPECT_FALSE(flight_foot(view, near, 0.6).has_value());
+  // A door, no flight.
+  map::TraversabilityMap d;
+  storey::test::scan_world(d, door_world(), {{-1.5f, 0, 0.5f}});
+  EXPECT_FALSE(flight_foot(d.view(), {{-0.5, 0.0, 0.0}}, 0.0).has_value());
+}
+
 TEST(PathCentring, BodyAtRestOnAFlightTakesTheTerrainPitch) {
   map::TraversabilityMap m;
   storey::test::scan_world(m, stair_world(), {{-1.5f, 0, 0.5f}, {0.75f, 0, 0.95f}});

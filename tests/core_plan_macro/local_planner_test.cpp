@@ -324,3 +324,90 @@ TEST(LocalPlanner, PathFailuresAreRetriedFromANewVantagePointBeforeTheSearchEnds
     EXPECT_GT(on.set_aside, 0u);
   }
 }
+
+// PlanOptions::flight_foot: a frontier beside a flight's foot (the treads above the sensor are
+// edge-on from the floor) whose viewpoint was reached and that stays a frontier is not set aside:
+// the robot is sent to the flight's foot (on its axis, facing up, before the first riser; here
+// as close as C_reach reaches, 1.4 m) and from there climbs blind. Without the switch the same
+// frontier is never sent there.
+namespace {
+World flight_room() {
+  World w;
+  w.add({-4, -3, -0.2f}, {6, 3, 0});
+  w.stairs(0.0f, -0.6f, 0.6f, 0.0f, 12, 0.15f, 0.30f);
+  w.add({0, -0.72f, 0}, {3.6f, -0.6f, 2.5f});
+  w.add({0, 0.6f, 0}, {3.6f, 0.72f, 2.5f});
+  w.add({-4, -3.2f, 0}, {6, -3, 2.5f});  // the room's walls
+  w.add({-4, 3, 0}, {6, 3.2f, 2.5f});
+  w.add({-4.2f, -3, 0}, {-4, 3, 2.5f});
+  return w;
+}
+
+struct FootRun {
+  bool to_foot = false;  // a new trajectory with the flight's-foot reason
+  Eigen::Vector3d foot_m = Eigen::Vector3d::Zero();
+  double foot_yaw = 0;
+  bool climbed = false;  // then a climb ending more than three treads up
+};
+
+FootRun run_flight_foot(bool on) {
+  Harness h;
+  const World w = flight_room();
+  h.observe(w, {-2.0f, 1.2f, 0}, 40000, 1);
+  h.observe(w, {-1.5f, -1.5f, 0}, 40000, 2);
+  PlanOptions po;
+  po.climb_blind = true;
+  po.flight_foot = on;
+  const auto view = h.map.view();
+  LocalPlanner lp(RobotModel{}, po, 0.1);
+  Eigen::Vector3f foot(-2.0f, 1.2f, 0);
+  double yaw = 0, t = 0;
+  FootRun run;
+  // The frontier clusters at the flight's foot (floor-level nodes within 1.2 m of it).
+  std::vector<storey::core::graph::FrontierCluster> at_foot;
+  for (const auto& c : h.clusters.clusters())
+    for (storey::core::graph::NodeId n : c.nodes) {
+      const Eigen::Vector3f p = h.graph.node(n).p_m;
+      if (p.z() < 0.1f && (p - Eigen::Vector3f(-0.4f, 0, 0)).head<2>().norm() < 1.2f) {
+        at_foot.push_back(c);
+        break;
+      }
+    }
+  EXPECT_FALSE(at_foot.empty());
+  for (int cycle = 0; cycle < 12 && !run.climbed; ++cycle) {
+    LocalPlanInput in = input(h, view, foot, t);
+    in.clusters = &at_foot;
+    in.robot_yaw_rad = yaw;
+    in.last_resort = true;
+    const LocalPlanResult r = lp.plan(in);
+    if (r.status != LocalPlanStatus::kNewTrajectory) {
+      t += 1.0;
+      continue;
+    }
+    const std::string reason = r.replan_reason;
+    const auto end = r.trajectory.pose(r.trajectory.t_end());
+    if (reason.rfind("to a flight's foot", 0) == 0) {
+      run.to_foot = true;
+      run.foot_m = r.target_m;
+      run.foot_yaw = r.target_yaw_rad;
+    }
+    if (reason.rfind("climb on", 0) == 0 && end.foot_m.z() > 0.5) run.climbed = true;
+    // The robot walks the trajectory to its end; the map is not rescanned (the frontier stays).
+    foot = end.foot_m.cast<float>();
+    yaw = end.yaw_rad;
+    t = r.trajectory.t_end() + 1.5;
+  }
+  return run;
+}
+}  // namespace
+
+TEST(LocalPlanner, AFrontierBesideAFlightSendsTheRobotToTheFlightsFootToClimb) {
+  const FootRun on = run_flight_foot(true);
+  ASSERT_TRUE(on.to_foot);
+  EXPECT_NEAR(on.foot_m.y(), 0.0, 0.15) << on.foot_m.transpose();  // on the axis
+  EXPECT_GE(on.foot_m.x(), -1.5) << on.foot_m.transpose();         // before the first riser
+  EXPECT_LE(on.foot_m.x(), -0.4) << on.foot_m.transpose();
+  EXPECT_NEAR(on.foot_yaw, 0.0, 0.15);  // facing up the flight
+  EXPECT_TRUE(on.climbed);
+  EXPECT_FALSE(run_flight_foot(false).to_foot);
+}
