@@ -311,20 +311,19 @@ std::optional<FlightFoot> flight_foot(const map::MapView& view,
   Eigen::Vector2d up(-std::sin(th), std::cos(th));
   if (up.dot(best->n) < 0) up = -up;
   if (up.dot(best->n) < std::cos(M_PI / 4)) return std::nullopt;  // not a line across the search
-  // The axis: up the riser's normal through its middle, moved sideways to the middle between the
-  // side walls as flight_axis finds them where it agrees on the direction (it reads the direction
-  // from tread heights, biased toward the better-seen side of a flight).
+  // The axis: flight_axis's (its direction from the tread heights and the risers' normals, its
+  // line centred between the side walls) where it agrees with the riser's normal within 25 deg;
+  // else (the heights of a flight seen from one side bias it) the riser's normal through its
+  // middle.
   const Eigen::Vector2d f2 = c - back_m * up;
   const double fz = height_at(f2, floor_z, 0.5 * step);
   const auto found = flight_axis(view, {f2.x(), f2.y(), std::isfinite(fz) ? fz : floor_z}, up, 1.0);
   if (!found) return std::nullopt;  // no rise along it: not a flight
-  FlightAxis a;
-  a.dir = up;
-  a.origin = c;
-  if (found->dir.dot(up) >= std::cos(15 * M_PI / 180)) {
-    const Eigen::Vector2d nrm(-up.y(), up.x());
-    a.origin += (found->origin - c).dot(nrm) * nrm;
-    a.width_m = found->width_m;
+  FlightAxis a = *found;
+  if (found->dir.dot(up) < std::cos(25 * M_PI / 180)) {  // biased: the riser's own line
+    a.dir = up;
+    a.origin = c;
+    a.width_m = INFINITY;
   }
   const std::optional<FlightAxis> axis = a;
   // Where to stand: the point on the axis nearest the riser, at least back_m before it, on floor
