@@ -215,6 +215,24 @@ bool LocalPlanner::retry_from_elsewhere(const LocalPlanInput& in, LocalPlanResul
   return false;
 }
 
+void LocalPlanner::adopt_target(const LocalPlanInput& in, const graph::FrontierCluster& c,
+                                LocalPlanResult& out) {
+  start_escapes_ = climbs_ = 0;
+  committed_ = false;
+  has_target_ = true;
+  remember_target(in, c);
+  target_m_ = out.target_m;
+  current_ = out.trajectory;
+  planned_at_s_ = in.t_s;
+  out.target_cluster = c.id;
+  out.status = LocalPlanStatus::kNewTrajectory;
+}
+
+double LocalPlanner::from_start_m(const Eigen::Vector3f& hit_m) const {
+  return std::isnan(hit_m.x()) ? std::numeric_limits<double>::infinity()
+                               : (hit_m.head<2>().cast<double>() - start_foot_m_.head<2>()).norm();
+}
+
 void LocalPlanner::adopt_move(const LocalPlanInput& in, LocalPlanResult& out, const char* reason,
                               bool committed) {
   has_target_ = true;
@@ -379,17 +397,9 @@ bool LocalPlanner::to_flight_foot(const LocalPlanInput& in, const graph::Frontie
   flight_feet_tried_.push_back(foot);
   flight_foot_ = *f;
   if (!free_start(in) || !to_foot_of(in, *f, out)) return false;
-  start_escapes_ = climbs_ = 0;
-  committed_ = false;
-  has_target_ = true;
+  adopt_target(in, c, out);
   flight_target_ = true;
-  remember_target(in, c);
-  target_m_ = out.target_m;
-  current_ = out.trajectory;
-  planned_at_s_ = in.t_s;
-  out.target_cluster = c.id;
   out.replan_reason = "to a flight's foot: a frontier beside it, on the axis where a climb starts";
-  out.status = LocalPlanStatus::kNewTrajectory;
   return true;
 }
 
@@ -459,7 +469,7 @@ bool LocalPlanner::climb_on(const LocalPlanInput& in, LocalPlanResult& out, bool
     }
     if (!lower) return false;
   }
-  // Up the axis over the support the map holds; unseen treads (edge-on) are bridged up to 0.45 m,
+  // Up the axis over the support the map holds; unseen treads (edge-on) are bridged up to 0.45 m.
   std::vector<Eigen::Vector3d> pts{foot};
   double z = foot.z(), s_last = 0, gap = 0;
   // From a flight's foot: the floor up to the first riser is walked level (often unseen: the
@@ -835,10 +845,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
       }
       // Boxed in where the last target left the robot (it cannot turn, or the body hits an
       // obstacle next to it): step away first, as Stage 3 does.
-      const bool near_hit =
-          !std::isnan(last_hit_m_.x()) &&
-          (last_hit_m_.head<2>().cast<double>() - start_foot_m_.head<2>()).norm() <=
-              opt_.start_blame_radius_m;
+      const bool near_hit = from_start_m(last_hit_m_) <= opt_.start_blame_radius_m;
       climb_escape = escape(in, out) || (near_hit && escape(in, out, &last_hit_m_));
       return climb_escape;
     }
@@ -1039,15 +1046,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
          ++k, ++attempts)
       ok = try_target(in, vps[k], out, &why);
     if (ok) {
-      start_escapes_ = climbs_ = 0;
-      committed_ = false;
-      has_target_ = true;
-      remember_target(in, (*in.clusters)[c.cluster_index]);
-      target_m_ = out.target_m;
-      current_ = out.trajectory;
-      planned_at_s_ = in.t_s;
-      out.target_cluster = c.cluster_id;
-      out.status = LocalPlanStatus::kNewTrajectory;
+      adopt_target(in, (*in.clusters)[c.cluster_index], out);
       return out;
     }
     failed.push_back({m, why, last_hit_m_});
@@ -1068,9 +1067,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   Eigen::Vector3f hit = kNoHitM;
   double hit_d = std::numeric_limits<double>::infinity();
   for (const Failed& f : failed) {
-    const double d = std::isnan(f.hit_m.x())
-                         ? std::numeric_limits<double>::infinity()
-                         : (f.hit_m.head<2>().cast<double>() - start_foot_m_.head<2>()).norm();
+    const double d = from_start_m(f.hit_m);
     boxed_in = boxed_in && d <= opt_.start_blame_radius_m;
     if (d < hit_d) hit_d = d, hit = f.hit_m;
   }

@@ -199,6 +199,12 @@ class LocalPlanner {
   bool retry_from_elsewhere(const LocalPlanInput& in, LocalPlanResult& out);
   void release_retry();
   void remember_retried(const SetAsideEntry& e);
+  // out's trajectory (Stage 3's, to cluster c's viewpoint or its flight's foot) becomes the
+  // current one, with c as the target.
+  void adopt_target(const LocalPlanInput& in, const graph::FrontierCluster& c,
+                    LocalPlanResult& out);
+  // Distance from the Stage 3 start to a body hit (infinite for kNoHitM) [m].
+  double from_start_m(const Eigen::Vector3f& hit_m) const;
   // out's trajectory (an escape, a climb, a walk: to a pose, not to a cluster) becomes the
   // current one; committed: driven to its end.
   void adopt_move(const LocalPlanInput& in, LocalPlanResult& out, const char* reason,

@@ -325,14 +325,13 @@ std::optional<FlightFoot> flight_foot(const map::MapView& view,
     a.origin = c;
     a.width_m = INFINITY;
   }
-  const std::optional<FlightAxis> axis = a;
   // Where to stand: the point on the axis nearest the riser, at least back_m before it, on floor
   // the robot can walk to (in C_reach).
-  const double t_riser = (c - axis->origin).dot(axis->dir);
+  const double t_riser = (c - a.origin).dot(a.dir);
   std::optional<map::SurfacePoint> sp;
   Eigen::Vector2d foot2;
   for (double b = back_m; b <= back_m + run_up_m + 1e-9 && !sp; b += 0.5 * s) {
-    foot2 = axis->origin + (t_riser - b) * axis->dir;
+    foot2 = a.origin + (t_riser - b) * a.dir;
     sp = view.support_surface_near(
         Eigen::Vector3f(float(foot2.x()), float(foot2.y()), float(floor_z)), 0.5 * step);
     if (sp && !sp->reachable) sp.reset();  // Stage 3's voxel A* walks C_reach
@@ -340,9 +339,8 @@ std::optional<FlightFoot> flight_foot(const map::MapView& view,
   if (!sp) return std::nullopt;
   FlightFoot out;
   out.foot_m = {foot2.x(), foot2.y(), double(sp->height_m)};
-  out.to_riser_m = t_riser - (foot2 - axis->origin).dot(axis->dir);
-  out.yaw_rad = std::atan2(axis->dir.y(), axis->dir.x());
-  out.axis = *axis;
+  out.yaw_rad = std::atan2(a.dir.y(), a.dir.x());
+  out.axis = a;
   out.riser_m = {c.x(), c.y(), floor_z};
   return out;
 }

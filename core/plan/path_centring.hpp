@@ -50,7 +50,8 @@ std::optional<FlightAxis> flight_axis(const map::MapView& view, const Eigen::Vec
 // before a flight is often unseen), on the level of `floor_z`. The first riser is found from the
 // support heights (the first tread a step above floor_z, the floor behind it, a higher tread
 // ahead) nearest to one of `near` (a frontier cluster's nodes) within `radius_m`; the axis then
-// comes from flight_axis (centred between the side walls). A climb from a frontier's own
+// comes from flight_axis (centred between the side walls), or is the riser's own normal where
+// flight_axis disagrees by more than 25 deg. A climb from a frontier's own
 // viewpoint fails when it stands 0.8 m or more before the first riser (flight_axis needs treads
 // 0.6 and 0.9 m ahead) or off the axis; an A* path onto the first tread meets it diagonally.
 struct FlightFoot {
@@ -58,7 +59,6 @@ struct FlightFoot {
   double yaw_rad = 0;                                // up the axis
   FlightAxis axis;
   Eigen::Vector3d riser_m = Eigen::Vector3d::Zero();  // middle of the first riser, at the floor
-  double to_riser_m = 0;                              // from foot_m along the axis
 };
 std::optional<FlightFoot> flight_foot(const map::MapView& view,
                                       const std::vector<Eigen::Vector3d>& near, double floor_z,
