@@ -436,7 +436,12 @@ bool LocalPlanner::climb_on(const LocalPlanInput& in, LocalPlanResult& out, bool
   // PlanOptions::climb_axis_ahead_m ahead on level ground. At a flight's foot (to_flight_foot) the
   // axis found from there.
   std::optional<FlightAxis> axis;
+  // With flight_foot, at a partial climb's end on the top tread: that climb's axis (no flight
+  // rises ahead any more; the landing ahead is what is left).
+  const ClimbedFlight* end_of =
+      plan_opt_.flight_foot && on_flight_only ? partial_climb_end(foot) : nullptr;
   if (given) axis = given->axis;
+  if (end_of) axis = end_of->axis;
   for (double ahead = 0.0;
        ahead <= (on_flight_only ? 0.0 : plan_opt_.climb_axis_ahead_m) + 1e-9 && !axis; ahead += 0.3)
     for (int k = 0; k < (on_flight_only ? 1 : 4) && !axis; ++k) {
@@ -493,28 +498,35 @@ bool LocalPlanner::climb_on(const LocalPlanInput& in, LocalPlanResult& out, bool
       gap += vs;
     }
   }
-  if (z - foot.z() < 0.5 * step && s_last < 0.3) return false;  // nothing to climb ahead
+  // With flight_foot, at a partial climb's end on the top tread: the landing ahead is what is left.
+  const bool climb_end = end_of != nullptr;
+  if (!climb_end && z - foot.z() < 0.5 * step && s_last < 0.3) return false;  // nothing to climb
   // Stairs only: on a ramp the body pitches less than the LiDAR's half field of view and the
   // ground ahead stays in sight. A flight shows its nosings as step edges (from its foot, where
   // few are marked, flight_foot found its treads a step apart).
-  int edges = given ? 3 : 0;
+  int edges = given || climb_end ? 3 : 0;
   for (const Eigen::Vector3d& p : pts)
     edges += view.is_step_edge(
         view.key_of(Eigen::Vector3f(float(p.x()), float(p.y()), float(p.z() - 0.01))));
   if (edges < 3) return false;
   // Onto the landing, blind: rays crossed the body's space there, no drop observed below. A
   // wall seen on it ends the landing there (test_stair's ends 0.8 m past the top tread: a climb
-  // planned before that wall was seen ran into it and was dropped mid-flight).
+  // planned before that wall was seen ran into it and was dropped mid-flight). At a partial
+  // climb's end rays up to look_above_m over the body count too: on the top tread the body
+  // pitches up with the flight and every ray passes over the landing's body space (office seed 1:
+  // the landing, 1.25 m deep to its wall, never seen at body height; no node grew there). Not
+  // from below: rays pass over the treads of a flight too (test_stair: "landings" mid-flight).
   const double body_lo = z + step, body_hi = z + robot_.body_height_m;
+  const double look_above_m = climb_end ? 0.6 : 0.0;
   const size_t n_flight = pts.size();
   bool unseen = false;
   for (double s = s_last + vs; s <= s_last + opt_.landing_step_m + 1e-9; s += vs) {
     const Eigen::Vector2d q = o + s * axis->dir;
     bool seen = false, wall = false;
-    for (double h = body_lo; h <= body_hi && !wall; h += vs) {
+    for (double h = body_lo; h <= body_hi + look_above_m && !wall; h += vs) {
       const map::Occupancy oc =
           view.occupancy(Eigen::Vector3f(float(q.x()), float(q.y()), float(h)));
-      wall = oc == map::Occupancy::kOccupied;
+      wall = oc == map::Occupancy::kOccupied && h <= body_hi;
       seen |= oc == map::Occupancy::kFree;
     }
     if (wall) break;
@@ -544,6 +556,7 @@ bool LocalPlanner::climb_on(const LocalPlanInput& in, LocalPlanResult& out, bool
   // Nothing seen past the last support (the treads above it unseen yet): a partial climb up to
   // it, at least two steps up; climbing goes on from there (below_climbed_landing).
   climb_partial_ = unseen && pts.size() == n_flight;
+  climb_axis_ = FlightAxis{o, axis->dir, axis->width_m};
   const double yaw = std::atan2(axis->dir.y(), axis->dir.x());
   if (climb_partial_) {
     if (z - foot.z() < 2 * step) return false;
@@ -565,11 +578,18 @@ bool LocalPlanner::climb_on(const LocalPlanInput& in, LocalPlanResult& out, bool
   return false;
 }
 
-bool LocalPlanner::below_climbed_landing(const Eigen::Vector3d& foot) const {
-  for (const ClimbedFlight& f : climbed_) {
+const LocalPlanner::ClimbedFlight* LocalPlanner::partial_climb_end(
+    const Eigen::Vector3d& foot) const {
+  for (const ClimbedFlight& f : climbed_)
     if (f.partial && (f.end_m.cast<double>() - foot).head<2>().norm() < 0.5 &&
         std::abs(foot.z() - f.end_m.z()) < robot_.step_height_m)
-      return true;  // where a partial climb ended
+      return &f;
+  return nullptr;
+}
+
+bool LocalPlanner::below_climbed_landing(const Eigen::Vector3d& foot) const {
+  if (partial_climb_end(foot)) return true;
+  for (const ClimbedFlight& f : climbed_) {
     if (foot.z() > f.top_z_m - robot_.step_height_m) continue;
     for (const Eigen::Vector3f& q : f.path_m)
       if ((q.cast<double>() - foot).head<2>().norm() < 0.5) return true;
@@ -673,6 +693,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   auto commit_climb = [&](const char* reason) {
     commit(reason);
     climbing_ = true;
+    climbing_axis_ = climb_axis_;
     return out;
   };
   // The target is a flight's foot (to_flight_foot): kept only by a kKeep.
@@ -812,7 +833,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     climb_done_s_ = in.t_s;
     const Eigen::Vector3f end = current_.pose(current_.t_end()).foot_m.cast<float>();
     const float top = end.z();
-    ClimbedFlight f{{}, top, end, climb_partial_};
+    ClimbedFlight f{{}, top, end, climb_partial_, climbing_axis_};
     for (double t = current_.t_start(); t <= current_.t_end(); t += 0.25) {
       const Eigen::Vector3f q = current_.pose(t).foot_m.cast<float>();
       if (q.z() < top - 0.05f) f.path_m.push_back(q);  // the flight, not the landing

@@ -192,6 +192,9 @@ class LocalPlanner {
   // Still on a flight climbed blind: its landing more than a step above (a climb dropped
   // mid-flight, its treads below never seen from above).
   bool below_climbed_landing(const Eigen::Vector3d& foot) const;
+  struct ClimbedFlight;
+  // The partial climb that ended where the robot stands (within 0.5 m, a step), or nullptr.
+  const ClimbedFlight* partial_climb_end(const Eigen::Vector3d& foot) const;
   void set_aside_cluster(const LocalPlanInput& in, const graph::FrontierCluster& c,
                          SetAsideReason reason, const Eigen::Vector3f& hit_m = kNoHitM);
   int expire_set_aside(const LocalPlanInput& in);
@@ -297,6 +300,8 @@ class LocalPlanner {
   bool climb_start_ = false;
   bool climbing_ = false;     // the committed move is a climb
   double climb_done_s_ = -1;  // when the last climb ended
+  FlightAxis climb_axis_;     // climb_on's last axis (origin: the walk's foot on it)
+  FlightAxis climbing_axis_;  // the committed climb's axis
   // Flights climbed blind: the climb's foot points and its landing height. Their frontiers stay
   // (the treads are edge-on from on the flight) and nothing resolves them from below; once the
   // landing's graph links to the flight's they would send the robot back down.
@@ -305,6 +310,7 @@ class LocalPlanner {
     float top_z_m;
     Eigen::Vector3f end_m;  // where the climb's walk ended
     bool partial;           // it ended at the last tread seen, mid-flight
+    FlightAxis axis;        // the climb's axis
   };
   bool climb_partial_ = false;  // climb_on's last walk ends mid-flight (nothing seen past it)
   std::vector<ClimbedFlight> climbed_;

@@ -411,3 +411,95 @@ TEST(LocalPlanner, AFrontierBesideAFlightSendsTheRobotToTheFlightsFootToClimb) {
   EXPECT_TRUE(on.climbed);
   EXPECT_FALSE(run_flight_foot(false).to_foot);
 }
+
+// A partial climb (nothing seen past the top tread from below) ends on the top tread. There the
+// body pitches up with the flight: every ray passes over the landing's body space, which is never
+// seen at body height (office seed 1, session 15: no node grew on the landing and the run ended
+// "complete"). With flight_foot, at a partial climb's end the landing counts as seen where rays
+// crossed up to 0.6 m over the body: the robot walks on onto it. Nothing observed there: it stays.
+namespace {
+World flight_to_landing() {
+  World w;
+  w.add({-4, -3, -0.2f}, {6, 3, 0});
+  w.stairs(0.0f, -0.6f, 0.6f, 0.0f, 7, 0.15f, 0.30f);   // up to 1.05 m at x 2.1
+  w.add({2.1f, -0.72f, -0.2f}, {3.35f, 0.72f, 1.05f});  // the landing, level with the top tread
+  w.add({3.35f, -0.87f, 0}, {3.5f, 0.87f, 4.5f});       // its wall
+  w.add({0, -0.87f, 0}, {3.35f, -0.6f, 4.5f});          // the stairwell's sides
+  w.add({0, 0.6f, 0}, {3.35f, 0.87f, 4.5f});
+  w.add({-4, -3.2f, 0}, {6, -3, 4.5f});  // the room's walls and ceiling
+  w.add({-4, 3, 0}, {6, 3.2f, 4.5f});
+  w.add({-4.2f, -3, 0}, {-4, 3, 4.5f});
+  w.add({-4, -3, 4.3f}, {6, 3, 4.5f});
+  return w;
+}
+}  // namespace
+
+TEST(LocalPlanner, APartialClimbsEndOnTheTopTreadWalksOnOntoALandingSeenOnlyFromAbove) {
+  Harness h;
+  const World w = flight_to_landing();
+  // From the floor, returns only up to the top tread's end: no ray crosses the landing.
+  for (const Eigen::Vector3f& f :
+       {Eigen::Vector3f(-2.0f, 1.2f, 0), Eigen::Vector3f(-1.5f, -1.5f, 0)}) {
+    std::vector<Eigen::Vector3f> pts;
+    const Eigen::Vector3f s = f + Eigen::Vector3f(0, 0, 0.5f);
+    for (const Eigen::Vector3f& p : storey::test::macro::scan(w, s, 40000, f.x() < -1.8f ? 1 : 2))
+      if (p.x() < 2.05f) pts.push_back(p);
+    h.insert(s, pts, f);
+  }
+  PlanOptions po;
+  po.climb_blind = true;
+  po.flight_foot = true;
+  LocalPlanner lp(RobotModel{}, po, 0.1);
+  Eigen::Vector3f foot(-2.0f, 1.2f, 0);
+  double yaw = 0, t = 0;
+  // The frontier at the flight's foot (the floor before the first riser, unseen).
+  std::vector<storey::core::graph::FrontierCluster> at_foot;
+  for (const auto& c : h.clusters.clusters())
+    for (storey::core::graph::NodeId n : c.nodes) {
+      const Eigen::Vector3f p = h.graph.node(n).p_m;
+      if (p.z() < 0.1f && (p - Eigen::Vector3f(-0.4f, 0, 0)).head<2>().norm() < 1.2f) {
+        at_foot.push_back(c);
+        break;
+      }
+    }
+  ASSERT_FALSE(at_foot.empty());
+  // Plans `cycles` times; the robot walks each trajectory to its end. Returns the last "climb on"
+  // trajectory's end (NaN: none).
+  auto run = [&](const storey::core::map::MapView& view, int cycles) {
+    Eigen::Vector3d last(NAN, NAN, NAN);
+    for (int cycle = 0; cycle < cycles; ++cycle) {
+      LocalPlanInput in = input(h, view, foot, t);
+      in.clusters = &at_foot;
+      in.robot_yaw_rad = yaw;
+      in.last_resort = true;
+      const LocalPlanResult r = lp.plan(in);
+      if (r.status != LocalPlanStatus::kNewTrajectory) {
+        t += 1.0;
+        continue;
+      }
+      const auto end = r.trajectory.pose(r.trajectory.t_end());
+      if (std::string(r.replan_reason).rfind("climb on", 0) == 0) last = end.foot_m;
+      foot = end.foot_m.cast<float>();
+      yaw = end.yaw_rad;
+      t = r.trajectory.t_end() + 1.5;
+    }
+    return last;
+  };
+  {
+    const auto view = h.map.view();
+    const Eigen::Vector3d top = run(view, 12);
+    ASSERT_TRUE(top.allFinite());
+    EXPECT_NEAR(top.z(), 1.05, 0.06) << top.transpose();  // partial: on the top tread
+    EXPECT_LE(top.x(), 2.1) << top.transpose();
+    // Nothing observed over the landing: no walk onto it.
+    EXPECT_FALSE(run(view, 4).allFinite());
+  }
+  // The pitched body's scan from the top tread: rays 12-42 deg up only.
+  h.observe(w, foot, 40000, 4, 0.21f, 0.73f);
+  const auto view = h.map.view();
+  const Eigen::Vector3d on = run(view, 4);
+  ASSERT_TRUE(on.allFinite());
+  EXPECT_NEAR(on.z(), 1.05, 0.06) << on.transpose();
+  EXPECT_GE(on.x(), 2.1 + 0.2) << on.transpose();   // on the landing
+  EXPECT_LE(on.x(), 3.35 - 0.3) << on.transpose();  // the body short of its wall
+}

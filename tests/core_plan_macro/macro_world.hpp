@@ -36,10 +36,16 @@ struct Harness {
   explicit Harness(const core::graph::GraphOptions& o = {}, uint64_t seed = 1)
       : graph(o), frontiers(o), clusters(o), viewpoints(o), rng(seed) {}
 
-  // One scan from 0.5 m above the feet, then graph/frontier cycles until idle.
-  void observe(const World& w, const Eigen::Vector3f& foot_m, int rays, uint32_t seed) {
+  // One scan from 0.5 m above the feet (rays between el_min and el_max [rad] of elevation), then
+  // graph/frontier cycles until idle.
+  void observe(const World& w, const Eigen::Vector3f& foot_m, int rays, uint32_t seed,
+               float el_min = -1.2f, float el_max = 1.0f) {
     const Eigen::Vector3f sensor = foot_m + Eigen::Vector3f(0, 0, 0.5f);
-    const auto pts = scan(w, sensor, rays, seed);
+    insert(sensor, scan(w, sensor, rays, seed, 12.f, el_min, el_max), foot_m);
+  }
+  // The returns pts seen from sensor (the robot's feet at foot_m), then graph/frontier cycles.
+  void insert(const Eigen::Vector3f& sensor, const std::vector<Eigen::Vector3f>& pts,
+              const Eigen::Vector3f& foot_m) {
     map.insert_scan(sensor, pts);
     map.update_traversability();
     map.update_reachable(foot_m);
