@@ -357,6 +357,42 @@ bool LocalPlanner::free_start(const LocalPlanInput& in) {
   return std::isfinite(best);
 }
 
+bool LocalPlanner::no_progress(const LocalPlanInput& in) {
+  const bool moved = !progress_foot_m_.allFinite() ||
+                     (in.robot_foot_m - progress_foot_m_).norm() > 0.15 ||
+                     std::abs(std::remainder(in.robot_yaw_rad - progress_yaw_, 2.0 * M_PI)) > 0.3;
+  if (!has_target_ || moved || plan_opt_.no_progress_s <= 0) {
+    progress_foot_m_ = in.robot_foot_m;
+    progress_yaw_ = in.robot_yaw_rad;
+    progress_t_s_ = in.t_s;
+    return false;
+  }
+  if (in.t_s - progress_t_s_ < plan_opt_.no_progress_s) return false;
+  progress_t_s_ = in.t_s;
+  ++no_progress_events_;
+  return true;
+}
+
+Eigen::Vector3f LocalPlanner::blocking_point(const LocalPlanInput& in) const {
+  const map::MapView& view = *in.view;
+  const double vs = view.voxel_size_m();
+  const Eigen::Vector3d c = in.robot_foot_m;
+  Eigen::Vector3f best = kNoHitM;
+  double best_d = std::numeric_limits<double>::infinity();
+  for (double dx = -0.6; dx <= 0.6 + 1e-9; dx += vs)
+    for (double dy = -0.6; dy <= 0.6 + 1e-9; dy += vs)
+      for (double h = robot_.step_height_m; h <= robot_.body_height_m + 1e-9; h += vs) {
+        const double d = std::hypot(dx, dy);
+        if (d >= best_d) continue;
+        const Eigen::Vector3f q(float(c.x() + dx), float(c.y() + dy), float(c.z() + h));
+        if (view.occupancy(q) == map::Occupancy::kOccupied) best = q, best_d = d;
+      }
+  if (std::isfinite(best_d)) return best;
+  return Eigen::Vector3f(float(c.x() + 0.45 * std::cos(in.robot_yaw_rad)),
+                         float(c.y() + 0.45 * std::sin(in.robot_yaw_rad)),
+                         float(c.z() + 0.5 * robot_.body_height_m));
+}
+
 // A straight step to the nearest pose where the body can turn (escape.hpp), from the Stage 3
 // start; with away_from, one that gains distance from that point.
 bool LocalPlanner::escape(const LocalPlanInput& in, LocalPlanResult& out,
@@ -719,9 +755,22 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   };
   out.set_aside_expired = expire_set_aside(in);
 
+  // No progress: the robot stood still with a target for no_progress_s. The target's cluster is
+  // set aside and the robot steps away from what its body meets (an escape; else plans anew).
+  bool stuck = false;
+  if (no_progress(in)) {
+    stuck = true;
+    const Eigen::Vector3f hit = blocking_point(in);
+    if (const graph::FrontierCluster* tc = track_target(in); tc && !committed_)
+      set_aside_cluster(in, *tc, SetAsideReason::kOverdue, hit);
+    has_target_ = committed_ = flight_target_ = climb_start_ = false;
+    if (free_start(in) && escape(in, out, &hit))
+      return commit("escape: no progress, away from what the body meets");
+  }
+
   // ---- Keep the current target unless there is a reason to replan.
   probe_mark(probe_, PlanStage::kLocalKeep);
-  const char* reason = "no target";
+  const char* reason = stuck ? "no progress" : "no target";
   int32_t kept_cluster = -1;  // the target's cluster at a periodic replan (target momentum)
   if (has_target_) {
     const graph::FrontierCluster* tc = track_target(in);

@@ -168,6 +168,7 @@ class LocalPlanner {
   void drop_target() { has_target_ = committed_ = false; }
   bool has_target() const { return has_target_; }
   bool committed() const { return has_target_ && committed_; }  // an escape or climb under way
+  uint64_t no_progress_events() const { return no_progress_events_; }  // PlanOptions::no_progress_s
   size_t set_aside_nodes() const { return set_aside_.size(); }
   uint64_t set_aside_expired() const { return expired_total_; }  // since construction
   // Diagnostics: the set-aside frontier nodes with their reasons; the entry of the set-aside
@@ -219,6 +220,12 @@ class LocalPlanner {
   void build_search_graph(const graph::ReachableGraph& g);
   // Stage 3 to one viewpoint; on failure *why says A* or trajectory.
   bool free_start(const LocalPlanInput& in);
+  // PlanOptions::no_progress_s: true once the robot stood that long with a target (then the
+  // clock starts again).
+  bool no_progress(const LocalPlanInput& in);
+  // The nearest occupied voxel in the body's height band within 0.6 m of the robot, else the
+  // point 0.45 m ahead of it: what a body that does not move meets.
+  Eigen::Vector3f blocking_point(const LocalPlanInput& in) const;
   // away_from: the start is boxed in by this obstacle: move away from it even if the body can
   // turn where it stands.
   bool escape(const LocalPlanInput& in, LocalPlanResult& out,
@@ -302,6 +309,10 @@ class LocalPlanner {
   double climb_done_s_ = -1;  // when the last climb ended
   FlightAxis climb_axis_;     // climb_on's last axis (origin: the walk's foot on it)
   FlightAxis climbing_axis_;  // the committed climb's axis
+  // No-progress watchdog: where and when the robot last moved (PlanOptions::no_progress_s).
+  Eigen::Vector3d progress_foot_m_ = Eigen::Vector3d::Constant(NAN);
+  double progress_yaw_ = 0, progress_t_s_ = 0;
+  uint64_t no_progress_events_ = 0;
   // Flights climbed blind: the climb's foot points and its landing height. Their frontiers stay
   // (the treads are edge-on from on the flight) and nothing resolves them from below; once the
   // landing's graph links to the flight's they would send the robot back down.

@@ -63,6 +63,13 @@ struct PlanOptions {
   // viewpoint 0.83 m before the first riser ended the office, seed 2, unclimbed). 0: from the
   // foot only. On, it moved which seeds end with a floor unreached (docs/RESULTS.md session 13).
   double climb_axis_ahead_m = 0.0;
+  // Beyond the paper, on in config/default.yaml (session 15; inert in every default run of
+  // docs/RESULTS.md): the robot stood still (moved < 0.15 m, turned < 0.3 rad) with a
+  // target for this long: the body meets something the plan did not expect, and every replan
+  // from there is the same (office seed 1 with session 14's deferred-flight change: 255 s against
+  // a table leg). The target's cluster is set aside and the robot steps away from the nearest
+  // obstacle. 0: off.
+  double no_progress_s = 0.0;
   // Beyond the paper (session 14, with climb_blind): a frontier cluster about to be set aside (its
   // viewpoint reached and still a frontier, or Stage 3 failing) with a flight's first riser within
   // 1.5 m is first approached at the flight's foot (flight_foot: on its axis, facing up, 0.45 m

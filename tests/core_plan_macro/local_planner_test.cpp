@@ -503,3 +503,57 @@ TEST(LocalPlanner, APartialClimbsEndOnTheTopTreadWalksOnOntoALandingSeenOnlyFrom
   EXPECT_GE(on.x(), 2.1 + 0.2) << on.transpose();   // on the landing
   EXPECT_LE(on.x(), 3.35 - 0.3) << on.transpose();  // the body short of its wall
 }
+
+// PlanOptions::no_progress_s: a robot that does not move while it has a target (its body meets
+// something the plan did not expect: office seed 1, session 15, 255 s against a table leg, every
+// replan the same) gets its target set aside and steps away, once per no_progress_s. Never while
+// it moves, never with the switch at 0.
+namespace {
+struct StuckRun {
+  uint64_t events = 0;
+  bool escaped = false;  // a trajectory with the no-progress escape's reason
+  size_t set_aside = 0;  // set-aside entries for kOverdue
+};
+StuckRun run_stuck(double no_progress_s, bool walk) {
+  const World w = corridor();
+  Harness h;
+  EXPECT_TRUE(scan_from(h, w, Eigen::Vector3f::Zero()));
+  PlanOptions po;
+  po.no_progress_s = no_progress_s;
+  LocalPlanner lp(RobotModel{}, po, 0.1);
+  const auto view = h.map.view();
+  StuckRun run;
+  BsplineTrajectory traj;
+  Eigen::Vector3d foot(0, 1.5, 0);
+  double yaw = 0;
+  for (double t = 0; t <= 25.0; t += 0.5) {
+    if (walk && !traj.empty()) {  // the robot on its reference
+      const auto p = traj.pose(std::clamp(t, traj.t_start(), traj.t_end()));
+      foot = p.foot_m, yaw = p.yaw_rad;
+    }
+    LocalPlanInput in = input(h, view, foot.cast<float>(), t);
+    in.robot_yaw_rad = yaw;
+    const LocalPlanResult r = lp.plan(in);
+    if (r.status != LocalPlanStatus::kNewTrajectory) continue;
+    traj = r.trajectory;
+    run.escaped |= std::string(r.replan_reason).rfind("escape: no progress", 0) == 0;
+  }
+  run.events = lp.no_progress_events();
+  for (const SetAsideEntry& e : lp.set_aside())
+    run.set_aside += e.reason == SetAsideReason::kOverdue;
+  return run;
+}
+}  // namespace
+
+TEST(LocalPlanner, ARobotThatDoesNotMoveWithATargetSetsItAsideAndStepsAway) {
+  const StuckRun stuck = run_stuck(10.0, false);
+  EXPECT_EQ(stuck.events, 2u);  // at 10 s and 20 s
+  EXPECT_TRUE(stuck.escaped);
+  EXPECT_GT(stuck.set_aside, 0u);
+  const StuckRun off = run_stuck(0.0, false);
+  EXPECT_EQ(off.events, 0u);
+  EXPECT_FALSE(off.escaped);
+  const StuckRun walking = run_stuck(10.0, true);
+  EXPECT_EQ(walking.events, 0u);
+  EXPECT_FALSE(walking.escaped);
+}

@@ -89,7 +89,11 @@ std::string exploration_diagnostics(const firmware::Autonomy& autonomy, const Gr
   for (const auto& [k, v] : reasons) out += ", " + k + " " + std::to_string(v);
   out += " (" + std::to_string(planner.set_aside().size() + planner.set_aside_expired()) +
          " over the run, " + std::to_string(planner.set_aside_expired()) +
-         " expired when the map near them changed)\n\n";
+         " expired when the map near them changed)\n";
+  out +=
+      "No-progress events (stood still with a target for plan.no_progress_s; target set aside, "
+      "stepped away): " +
+      std::to_string(planner.no_progress_events()) + "\n\n";
 
   // ---- 2. Coverage gaps: what the map holds at uncovered ground-truth traversable voxels.
   const auto& map = autonomy.map_for_record();
