@@ -880,9 +880,19 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     climbing_ = false;
     climb_deferrals_ = 0;
     climb_done_s_ = in.t_s;
-    const Eigen::Vector3f end = current_.pose(current_.t_end()).foot_m.cast<float>();
+    Eigen::Vector3f end = current_.pose(current_.t_end()).foot_m.cast<float>();
+    bool partial = climb_partial_;
+    // With flight_foot, a climb dropped more than a step below its planned end (a collision
+    // predicted once the treads ahead were mapped) climbed up to where the robot stands: a partial
+    // climb ending there. Recorded up to its planned "landing", the flight's frontiers above the
+    // robot were ignored for good (test_stair seed 1: a "landing" mid-flight, dropped on the first
+    // tread, the flight never climbed).
+    if (plan_opt_.flight_foot && in.robot_foot_m.z() < end.z() - robot_.step_height_m) {
+      end = in.robot_foot_m.cast<float>();
+      partial = true;
+    }
     const float top = end.z();
-    ClimbedFlight f{{}, top, end, climb_partial_, climbing_axis_};
+    ClimbedFlight f{{}, top, end, partial, climbing_axis_};
     for (double t = current_.t_start(); t <= current_.t_end(); t += 0.25) {
       const Eigen::Vector3f q = current_.pose(t).foot_m.cast<float>();
       if (q.z() < top - 0.05f) f.path_m.push_back(q);  // the flight, not the landing
