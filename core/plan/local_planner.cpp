@@ -539,8 +539,11 @@ bool LocalPlanner::climb_on(const LocalPlanInput& in, LocalPlanResult& out, bool
   if (!climb_end && z - foot.z() < 0.5 * step && s_last < 0.3) return false;  // nothing to climb
   // Stairs only: on a ramp the body pitches less than the LiDAR's half field of view and the
   // ground ahead stays in sight. A flight shows its nosings as step edges (from its foot, where
-  // few are marked, flight_foot found its treads a step apart).
-  int edges = given || climb_end ? 3 : 0;
+  // few are marked, flight_foot found its treads a step apart). With flight_foot, on the flight
+  // the lower tread behind counts for two: near the top few nosings ahead are marked (office
+  // seed 4: 1.3 m below the landing, one step edge; every Stage 3 trajectory from there hit the
+  // stairwell and each frontier was set aside in turn until "complete").
+  int edges = given || climb_end ? 3 : plan_opt_.flight_foot && on_flight_only ? 2 : 0;
   for (const Eigen::Vector3d& p : pts)
     edges += view.is_step_edge(
         view.key_of(Eigen::Vector3f(float(p.x()), float(p.y()), float(p.z() - 0.01))));
