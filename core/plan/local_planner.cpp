@@ -217,7 +217,7 @@ bool LocalPlanner::retry_from_elsewhere(const LocalPlanInput& in, LocalPlanResul
 
 void LocalPlanner::adopt_target(const LocalPlanInput& in, const graph::FrontierCluster& c,
                                 LocalPlanResult& out) {
-  start_escapes_ = climbs_ = 0;
+  start_escapes_ = climbs_ = descents_ = 0;
   committed_ = false;
   has_target_ = true;
   remember_target(in, c);
@@ -624,6 +624,65 @@ const LocalPlanner::ClimbedFlight* LocalPlanner::partial_climb_end(
         std::abs(foot.z() - f.end_m.z()) < robot_.step_height_m)
       return &f;
   return nullptr;
+}
+
+// On a flight in a stairwell a B-spline's curve swings the body into the side walls: every Stage 3
+// trajectory from there hits them next to the start, and without this each frontier was set
+// aside in turn until "complete" (office seed 4: on the way down, floor 0 left at 80.9 %). The
+// flight's treads below are in the map (the robot came up them, and the LiDAR looks down them):
+// walk straight down its axis over that support, at a constant yaw along the axis (backwards if
+// the robot faces up), to 0.5 m of level floor past its foot (from a landing, first level to
+// the top riser).
+bool LocalPlanner::descend_flight(const LocalPlanInput& in, LocalPlanResult& out) {
+  const map::MapView& view = *in.view;
+  const Eigen::Vector3d foot = in.robot_foot_m;
+  const double vs = view.voxel_size_m(), step = robot_.step_height_m;
+  // From the robot, or from up to 0.6 m ahead on level ground (flight_axis wants the drop 0.6
+  // and 0.9 m ahead; on a landing the robot stands farther back from the top riser).
+  for (int k = 0; k < 8; ++k) {
+    const double yaw0 = in.robot_yaw_rad + (k % 4) * M_PI / 2, ahead = k < 4 ? 0.0 : 0.6;
+    const Eigen::Vector2d face(std::cos(yaw0), std::sin(yaw0));
+    Eigen::Vector3d from = foot;
+    from.head<2>() += ahead * face;
+    if (ahead > 0) {
+      const auto sp = view.support_surface_near(from.cast<float>(), 0.5 * step);
+      if (!sp || sp->state != map::TravState::kTraversable) continue;
+      from.z() = sp->height_m;
+    }
+    const auto axis = flight_axis(view, from, face, -1.0);
+    if (!axis) continue;
+    const Eigen::Vector2d o =
+        axis->origin + axis->dir * (foot.head<2>() - axis->origin).dot(axis->dir);
+    std::vector<Eigen::Vector3d> pts{foot};
+    double z = foot.z(), level = 0, gap = 0;
+    bool down = false;  // level is counted only past the first drop
+    for (double s = vs; s <= 8.0 && (!down || level < 0.5) && gap <= 0.45; s += vs) {
+      const Eigen::Vector2d q = o + s * axis->dir;
+      const double drop = step + 0.84 * gap;  // past an unseen tread, down to a 40 deg grade
+      const auto sp = view.support_surface_near(
+          Eigen::Vector3f(float(q.x()), float(q.y()), float(z - 0.5 * drop)), 0.5 * drop + 0.03);
+      if (!sp || sp->height_m > z + 0.03) {  // unseen, or rising
+        gap += vs;
+        continue;
+      }
+      down |= sp->height_m < z - 0.03;
+      level = sp->height_m < z - 0.03 ? 0.0 : level + vs;
+      z = std::min<double>(z, sp->height_m), gap = 0;
+      pts.emplace_back(q.x(), q.y(), z);
+    }
+    if (foot.z() - z < 2 * step || level < 0.3) continue;  // not to a floor two steps down
+    // The body moves over the nosings (as climb_on's): no lower than the next tread 0.2 m back.
+    const std::vector<Eigen::Vector3d> sup = pts;
+    for (Eigen::Vector3d& p : pts)
+      for (const Eigen::Vector3d& q : sup) {
+        const double ds = (p.head<2>() - q.head<2>()).dot(axis->dir);
+        if (ds > 0 && ds <= 0.2 + 1e-6) p.z() = std::max(p.z(), q.z());
+      }
+    double yaw = std::atan2(axis->dir.y(), axis->dir.x());
+    if (std::cos(yaw - in.robot_yaw_rad) < 0) yaw += M_PI;  // facing up: backwards down
+    if (straight_walk(in, pts, std::remainder(yaw, 2.0 * M_PI), out)) return true;
+  }
+  return false;
 }
 
 bool LocalPlanner::below_climbed_landing(const Eigen::Vector3d& foot) const {
@@ -1157,6 +1216,18 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   if (boxed_in && start_escapes_ < opt_.max_start_escapes && escape(in, out, &hit)) {
     ++start_escapes_;
     return commit("escape: boxed in by an obstacle next to the start");
+  }
+  // Every body hit within 2.5 m, none above the robot (office seed 4: from the landing, 1.1 m
+  // down the flight against the stairwell's side): if a flight goes down from here, it is the
+  // way to all of them.
+  bool hits_near = !failed.empty();
+  for (const Failed& f : failed)
+    hits_near = hits_near && from_start_m(f.hit_m) <= 2.5 &&
+                f.hit_m.z() < in.robot_foot_m.z() + robot_.step_height_m;
+  if ((boxed_in || hits_near) && plan_opt_.climb_blind && descents_ < 2 &&
+      descend_flight(in, out)) {
+    ++descents_;
+    return commit("descend: boxed in on a flight, straight down its axis to the floor below");
   }
   // Stage 3 failed for these clusters: after max_failures cycles a cluster is set aside.
   for (const auto& [m, why, hit_m] : failed) {

@@ -247,6 +247,10 @@ class LocalPlanner {
   // Stage 3 to f's stand point, else up to 0.75 m farther back on the axis (room to turn).
   bool to_foot_of(const LocalPlanInput& in, const FlightFoot& f, LocalPlanResult& out);
   // A straight walk at constant yaw through `pts` (foot points), checked against the map.
+  // Boxed in on a flight (every Stage 3 body hit next to the start): straight down the flight's
+  // axis over the support the map holds to the floor below, facing whichever way along the axis
+  // the robot faces (see local_planner.cpp).
+  bool descend_flight(const LocalPlanInput& in, LocalPlanResult& out);
   bool straight_walk(const LocalPlanInput& in, const std::vector<Eigen::Vector3d>& pts, double yaw,
                      LocalPlanResult& out);
   void take_walk(StraightWalk&& w, double yaw, LocalPlanResult& out);
@@ -304,6 +308,7 @@ class LocalPlanner {
   };
   std::optional<DeferredClimb> deferred_climb_;
   int climb_deferrals_ = 0;  // climbs deferred since the last climb
+  int descents_ = 0;         // descend_flight walks since the last target
   bool climb_start_ = false;
   bool climbing_ = false;     // the committed move is a climb
   double climb_done_s_ = -1;  // when the last climb ended

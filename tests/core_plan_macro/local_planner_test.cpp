@@ -557,3 +557,61 @@ TEST(LocalPlanner, ARobotThatDoesNotMoveWithATargetSetsItAsideAndStepsAway) {
   EXPECT_EQ(walking.events, 0u);
   EXPECT_FALSE(walking.escaped);
 }
+
+// Boxed in on a flight: in a stairwell too narrow for the body to turn in, facing up, with the
+// only frontiers on the floor below, every Stage 3 trajectory hits the side walls next to the
+// start. Before, each frontier was set aside in turn until "complete" (office seed 4, session
+// 15); with climb_blind the robot walks straight down the flight's axis (backwards) to the floor.
+namespace {
+World narrow_flight() {
+  World w;
+  w.add({-6, -3, -0.2f}, {6, 3, 0});
+  w.stairs(0.0f, -0.5f, 0.5f, 0.0f, 12, 0.15f, 0.30f);  // up to 1.8 m at x 3.6
+  w.add({3.6f, -0.5f, -0.2f}, {5.0f, 0.5f, 1.8f});      // the landing
+  w.add({0, -0.7f, 0}, {5.0f, -0.5f, 3.5f});            // the stairwell, 1 m wide
+  w.add({0, 0.5f, 0}, {5.0f, 0.7f, 3.5f});
+  w.add({5.0f, -0.6f, 0}, {5.2f, 0.6f, 3.5f});
+  return w;
+}
+}  // namespace
+
+TEST(LocalPlanner, BoxedInOnAFlightWalksStraightDownItsAxisToTheFloor) {
+  Harness h;
+  const World w = narrow_flight();
+  h.observe(w, {-2.0f, 0, 0}, 40000, 1);
+  h.observe(w, {-1.0f, 1.5f, 0}, 40000, 2);
+  const Eigen::Vector3f on(2.25f, 0, 1.2f);  // tread 8, facing up
+  h.observe(w, on, 40000, 3);
+  std::vector<storey::core::graph::FrontierCluster> below;
+  for (const auto& c : h.clusters.clusters())
+    if (std::all_of(c.nodes.begin(), c.nodes.end(),
+                    [&](auto n) { return h.graph.node(n).p_m.z() < 0.1f; }))
+      below.push_back(c);
+  ASSERT_FALSE(below.empty());
+  PlanOptions po;
+  po.climb_blind = true;
+  LocalPlanner lp(RobotModel{}, po, 0.1);
+  const auto view = h.map.view();
+  Eigen::Vector3d foot = on.cast<double>();
+  double yaw = 0, t = 0;
+  bool descended = false;
+  for (int cycle = 0; cycle < 12 && !descended; ++cycle) {
+    LocalPlanInput in = input(h, view, foot.cast<float>(), t);
+    in.clusters = &below;
+    in.robot_yaw_rad = yaw;
+    const LocalPlanResult r = lp.plan(in);
+    t += 0.5;
+    if (r.status != LocalPlanStatus::kNewTrajectory) continue;
+    const auto end = r.trajectory.pose(r.trajectory.t_end());
+    if (std::string(r.replan_reason).rfind("descend", 0) == 0) {
+      descended = true;
+      EXPECT_LT(end.foot_m.z(), 0.05) << end.foot_m.transpose();  // on the floor
+      EXPECT_LT(end.foot_m.x(), -0.2) << end.foot_m.transpose();  // past the flight's foot
+      EXPECT_NEAR(std::abs(end.foot_m.y()), 0.0, 0.15);           // along its axis
+      EXPECT_NEAR(std::abs(std::remainder(end.yaw_rad, 2 * M_PI)), 0.0, 0.2);  // backwards
+    }
+    foot = end.foot_m, yaw = end.yaw_rad;
+    t = r.trajectory.t_end() + 0.5;
+  }
+  EXPECT_TRUE(descended);
+}
