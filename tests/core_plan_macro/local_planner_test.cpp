@@ -4,6 +4,7 @@
 #include "core/plan/local_planner.hpp"
 
 #include <cstdio>
+#include <optional>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -343,6 +344,44 @@ World flight_room() {
   return w;
 }
 
+// The frontier clusters at the foot of a flight rising from x = 0 (floor-level nodes within
+// 1.2 m of (-0.4, 0)).
+std::vector<storey::core::graph::FrontierCluster> clusters_at_foot(const Harness& h) {
+  std::vector<storey::core::graph::FrontierCluster> at_foot;
+  for (const auto& c : h.clusters.clusters())
+    for (storey::core::graph::NodeId n : c.nodes) {
+      const Eigen::Vector3f p = h.graph.node(n).p_m;
+      if (p.z() < 0.1f && (p - Eigen::Vector3f(-0.4f, 0, 0)).head<2>().norm() < 1.2f) {
+        at_foot.push_back(c);
+        break;
+      }
+    }
+  return at_foot;
+}
+
+// One planning cycle on `clusters` (last resort allowed), the robot at foot / yaw at time t. A new
+// trajectory is walked to its end (foot, yaw there; t 1.5 s after its end; the map is not
+// rescanned) and returned; else t moves on 1 s.
+std::optional<LocalPlanResult> walked_cycle(
+    LocalPlanner& lp, const Harness& h, const storey::core::map::MapView& view,
+    const std::vector<storey::core::graph::FrontierCluster>& clusters, Eigen::Vector3f& foot,
+    double& yaw, double& t) {
+  LocalPlanInput in = input(h, view, foot, t);
+  in.clusters = &clusters;
+  in.robot_yaw_rad = yaw;
+  in.last_resort = true;
+  LocalPlanResult r = lp.plan(in);
+  if (r.status != LocalPlanStatus::kNewTrajectory) {
+    t += 1.0;
+    return std::nullopt;
+  }
+  const auto end = r.trajectory.pose(r.trajectory.t_end());
+  foot = end.foot_m.cast<float>();
+  yaw = end.yaw_rad;
+  t = r.trajectory.t_end() + 1.5;
+  return r;
+}
+
 struct FootRun {
   bool to_foot = false;  // a new trajectory with the flight's-foot reason
   Eigen::Vector3d foot_m = Eigen::Vector3d::Zero();
@@ -363,39 +402,18 @@ FootRun run_flight_foot(bool on) {
   Eigen::Vector3f foot(-2.0f, 1.2f, 0);
   double yaw = 0, t = 0;
   FootRun run;
-  // The frontier clusters at the flight's foot (floor-level nodes within 1.2 m of it).
-  std::vector<storey::core::graph::FrontierCluster> at_foot;
-  for (const auto& c : h.clusters.clusters())
-    for (storey::core::graph::NodeId n : c.nodes) {
-      const Eigen::Vector3f p = h.graph.node(n).p_m;
-      if (p.z() < 0.1f && (p - Eigen::Vector3f(-0.4f, 0, 0)).head<2>().norm() < 1.2f) {
-        at_foot.push_back(c);
-        break;
-      }
-    }
+  const std::vector<storey::core::graph::FrontierCluster> at_foot = clusters_at_foot(h);
   EXPECT_FALSE(at_foot.empty());
   for (int cycle = 0; cycle < 12 && !run.climbed; ++cycle) {
-    LocalPlanInput in = input(h, view, foot, t);
-    in.clusters = &at_foot;
-    in.robot_yaw_rad = yaw;
-    in.last_resort = true;
-    const LocalPlanResult r = lp.plan(in);
-    if (r.status != LocalPlanStatus::kNewTrajectory) {
-      t += 1.0;
-      continue;
-    }
-    const std::string reason = r.replan_reason;
-    const auto end = r.trajectory.pose(r.trajectory.t_end());
+    const auto r = walked_cycle(lp, h, view, at_foot, foot, yaw, t);
+    if (!r) continue;
+    const std::string reason = r->replan_reason;
     if (reason.rfind("to a flight's foot", 0) == 0) {
       run.to_foot = true;
-      run.foot_m = r.target_m;
-      run.foot_yaw = r.target_yaw_rad;
+      run.foot_m = r->target_m;
+      run.foot_yaw = r->target_yaw_rad;
     }
-    if (reason.rfind("climb on", 0) == 0 && end.foot_m.z() > 0.5) run.climbed = true;
-    // The robot walks the trajectory to its end; the map is not rescanned (the frontier stays).
-    foot = end.foot_m.cast<float>();
-    yaw = end.yaw_rad;
-    t = r.trajectory.t_end() + 1.5;
+    if (reason.rfind("climb on", 0) == 0 && foot.z() > 0.5f) run.climbed = true;
   }
   return run;
 }
@@ -453,35 +471,15 @@ TEST(LocalPlanner, APartialClimbsEndOnTheTopTreadWalksOnOntoALandingSeenOnlyFrom
   Eigen::Vector3f foot(-2.0f, 1.2f, 0);
   double yaw = 0, t = 0;
   // The frontier at the flight's foot (the floor before the first riser, unseen).
-  std::vector<storey::core::graph::FrontierCluster> at_foot;
-  for (const auto& c : h.clusters.clusters())
-    for (storey::core::graph::NodeId n : c.nodes) {
-      const Eigen::Vector3f p = h.graph.node(n).p_m;
-      if (p.z() < 0.1f && (p - Eigen::Vector3f(-0.4f, 0, 0)).head<2>().norm() < 1.2f) {
-        at_foot.push_back(c);
-        break;
-      }
-    }
+  const std::vector<storey::core::graph::FrontierCluster> at_foot = clusters_at_foot(h);
   ASSERT_FALSE(at_foot.empty());
   // Plans `cycles` times; the robot walks each trajectory to its end. Returns the last "climb on"
   // trajectory's end (NaN: none).
   auto run = [&](const storey::core::map::MapView& view, int cycles) {
     Eigen::Vector3d last(NAN, NAN, NAN);
     for (int cycle = 0; cycle < cycles; ++cycle) {
-      LocalPlanInput in = input(h, view, foot, t);
-      in.clusters = &at_foot;
-      in.robot_yaw_rad = yaw;
-      in.last_resort = true;
-      const LocalPlanResult r = lp.plan(in);
-      if (r.status != LocalPlanStatus::kNewTrajectory) {
-        t += 1.0;
-        continue;
-      }
-      const auto end = r.trajectory.pose(r.trajectory.t_end());
-      if (std::string(r.replan_reason).rfind("climb on", 0) == 0) last = end.foot_m;
-      foot = end.foot_m.cast<float>();
-      yaw = end.yaw_rad;
-      t = r.trajectory.t_end() + 1.5;
+      const auto r = walked_cycle(lp, h, view, at_foot, foot, yaw, t);
+      if (r && std::string(r->replan_reason).rfind("climb on", 0) == 0) last = foot.cast<double>();
     }
     return last;
   };
