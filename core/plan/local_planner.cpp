@@ -455,6 +455,38 @@ void LocalPlanner::take_walk(StraightWalk&& w, double yaw, LocalPlanResult& out)
   out.real_until_s = out.trajectory.t_end();
 }
 
+namespace {
+
+// The flight rising (sign +1) or falling (-1) ahead of a robot at `foot` facing `face` (unit),
+// looked for from `ahead` m along `face` on level ground of the same floor (flight_axis wants the
+// treads 0.6 and 0.9 m ahead of where it starts).
+std::optional<FlightAxis> axis_facing(const map::MapView& view, const Eigen::Vector3d& foot,
+                                      const Eigen::Vector2d& face, double ahead, double step_m,
+                                      double sign) {
+  Eigen::Vector3d from = foot;
+  from.head<2>() += ahead * face;
+  if (ahead > 0) {
+    const auto sp = view.support_surface_near(from.cast<float>(), 0.5 * step_m);
+    if (!sp || sp->state != map::TravState::kTraversable) return std::nullopt;
+    from.z() = sp->height_m;
+  }
+  return flight_axis(view, from, face, sign);
+}
+
+// The body moves over the nosings, not down into each tread: each point no lower than a support
+// point of `sup` within 0.2 m toward the flight's higher end (`up`, unit; a stepwise profile,
+// smoothed by the B-spline, dips the body into the risers).
+void keep_over_nosings(std::vector<Eigen::Vector3d>& pts, const std::vector<Eigen::Vector3d>& sup,
+                       const Eigen::Vector2d& up) {
+  for (Eigen::Vector3d& p : pts)
+    for (const Eigen::Vector3d& q : sup) {
+      const double ds = (q.head<2>() - p.head<2>()).dot(up);
+      if (ds > 0 && ds <= 0.2 + 1e-6) p.z() = std::max(p.z(), q.z());
+    }
+}
+
+}  // namespace
+
 // On a flight the body pitches with the stairs and the LiDAR's +-15 deg look over the treads
 // ahead: the rest of the flight and its landing are never seen from on it, and a frontier there
 // stays one however long the robot stands on it. Facing up a flight (its axis from the map's
@@ -483,14 +515,7 @@ bool LocalPlanner::climb_on(const LocalPlanInput& in, LocalPlanResult& out, bool
     for (int k = 0; k < (on_flight_only ? 1 : 4) && !axis; ++k) {
       const double yaw = in.robot_yaw_rad + k * M_PI / 2;
       const Eigen::Vector2d face(std::cos(yaw), std::sin(yaw));
-      Eigen::Vector3d from = foot;
-      from.head<2>() += ahead * face;
-      if (ahead > 0) {  // level ground ahead, the same floor
-        const auto sp = view.support_surface_near(from.cast<float>(), 0.5 * robot_.step_height_m);
-        if (!sp || sp->state != map::TravState::kTraversable) continue;
-        from.z() = sp->height_m;
-      }
-      axis = flight_axis(view, from, face, 1.0);
+      axis = axis_facing(view, foot, face, ahead, robot_.step_height_m, 1.0);
       if (axis && axis->dir.dot(face) < std::cos(M_PI / 4)) axis.reset();
     }
   if (!axis) return false;
@@ -534,8 +559,7 @@ bool LocalPlanner::climb_on(const LocalPlanInput& in, LocalPlanResult& out, bool
       gap += vs;
     }
   }
-  // With flight_foot, at a partial climb's end on the top tread: the landing ahead is what is left.
-  const bool climb_end = end_of != nullptr;
+  const bool climb_end = end_of != nullptr;  // the landing ahead is what is left
   if (!climb_end && z - foot.z() < 0.5 * step && s_last < 0.3) return false;  // nothing to climb
   // Stairs only: on a ramp the body pitches less than the LiDAR's half field of view and the
   // ground ahead stays in sight. A flight shows its nosings as step edges (from its foot, where
@@ -579,19 +603,15 @@ bool LocalPlanner::climb_on(const LocalPlanInput& in, LocalPlanResult& out, bool
         return false;
     pts.emplace_back(q.x(), q.y(), z);
   }
-  // The body moves over the nosings, not down into each tread: heights no lower than the line
-  // from the robot to the last support, nor than the next tread within 0.2 m ahead (a stepwise
-  // profile, smoothed by the B-spline, dips the body into the risers).
+  // The body moves over the nosings: heights no lower than the line from the robot to the last
+  // support, nor than the next tread within 0.2 m ahead.
   const double s_top = std::max(s_last, vs);
   const std::vector<Eigen::Vector3d> sup = pts;
   for (Eigen::Vector3d& p : pts) {
     const double s = std::clamp((p.head<2>() - o).dot(axis->dir), 0.0, s_top);
     p.z() = std::max(p.z(), foot.z() + (z - foot.z()) * s / s_top);
-    for (const Eigen::Vector3d& q : sup) {
-      const double ds = (q.head<2>() - p.head<2>()).dot(axis->dir);
-      if (ds > 0 && ds <= 0.2 + 1e-6) p.z() = std::max(p.z(), q.z());
-    }
   }
+  keep_over_nosings(pts, sup, axis->dir);
   // Nothing seen past the last support (the treads above it unseen yet): a partial climb up to
   // it, at least two steps up; climbing goes on from there (below_climbed_landing).
   climb_partial_ = unseen && pts.size() == n_flight;
@@ -642,14 +662,7 @@ bool LocalPlanner::descend_flight(const LocalPlanInput& in, LocalPlanResult& out
   for (int k = 0; k < 8; ++k) {
     const double yaw0 = in.robot_yaw_rad + (k % 4) * M_PI / 2, ahead = k < 4 ? 0.0 : 0.6;
     const Eigen::Vector2d face(std::cos(yaw0), std::sin(yaw0));
-    Eigen::Vector3d from = foot;
-    from.head<2>() += ahead * face;
-    if (ahead > 0) {
-      const auto sp = view.support_surface_near(from.cast<float>(), 0.5 * step);
-      if (!sp || sp->state != map::TravState::kTraversable) continue;
-      from.z() = sp->height_m;
-    }
-    const auto axis = flight_axis(view, from, face, -1.0);
+    const auto axis = axis_facing(view, foot, face, ahead, step, -1.0);
     if (!axis) continue;
     const Eigen::Vector2d o =
         axis->origin + axis->dir * (foot.head<2>() - axis->origin).dot(axis->dir);
@@ -671,13 +684,7 @@ bool LocalPlanner::descend_flight(const LocalPlanInput& in, LocalPlanResult& out
       pts.emplace_back(q.x(), q.y(), z);
     }
     if (foot.z() - z < 2 * step || level < 0.3) continue;  // not to a floor two steps down
-    // The body moves over the nosings (as climb_on's): no lower than the next tread 0.2 m back.
-    const std::vector<Eigen::Vector3d> sup = pts;
-    for (Eigen::Vector3d& p : pts)
-      for (const Eigen::Vector3d& q : sup) {
-        const double ds = (p.head<2>() - q.head<2>()).dot(axis->dir);
-        if (ds > 0 && ds <= 0.2 + 1e-6) p.z() = std::max(p.z(), q.z());
-      }
+    keep_over_nosings(pts, std::vector<Eigen::Vector3d>(pts), -axis->dir);
     double yaw = std::atan2(axis->dir.y(), axis->dir.x());
     if (std::cos(yaw - in.robot_yaw_rad) < 0) yaw += M_PI;  // facing up: backwards down
     if (straight_walk(in, pts, std::remainder(yaw, 2.0 * M_PI), out)) return true;
