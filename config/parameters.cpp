@@ -173,6 +173,7 @@ void read_plan(SectionReader&& r, core::plan::PlanOptions& o) {
   r.get("path_retries", o.path_retries, Range{0, 10});
   r.get("climb_axis_ahead_m", o.climb_axis_ahead_m, Range{0.0, 1.5});
   r.get("flight_foot", o.flight_foot);
+  r.get("brake_start", o.brake_start);
   r.get("no_progress_s", o.no_progress_s, Range{0.0, 600.0});
   r.get("incremental_maintenance", o.incremental_maintenance);
 }

@@ -192,10 +192,15 @@ void Autonomy::map_step() {
     startup_support_done_ = true;
     startup_points_ = insert_startup_support(foot);
   } else if (opt_.params.plan.climb_blind && scans_inserted_ > 0 &&
-             (foot - last_support_foot_).norm() > 1.0f &&
+             ((foot - last_support_foot_).norm() > 1.0f ||
+              (opt_.params.plan.flight_foot && std::abs(foot.z() - last_support_foot_.z()) >
+                                                   float(opt_.params.robot.step_height_m))) &&
              support_fraction(map_.view(), foot) < 0.5f) {
     // Stepped onto ground the LiDAR has not seen (a landing reached blind from a flight, whose
-    // pitch kept the LiDAR looking over it): the legs stand on it, enter it as well.
+    // pitch kept the LiDAR looking over it): the legs stand on it, enter it as well. Once per
+    // metre; with plan.flight_foot also per level: entered on the top tread, the landing 0.94 m
+    // on and a step up was not (house seed 8, session 16: no node grew on the upper floor,
+    // "complete" with it at 10 %).
     insert_startup_support(foot);
   }
   map_.update_traversability();
@@ -295,6 +300,9 @@ void Autonomy::plan_step() {
   in.viewpoints = &w.viewpoints;
   in.robot_foot_m = pose.position();
   in.robot_yaw_rad = pose.yaw_rad;
+  in.robot_velocity_mps = {
+      std::cos(pose.yaw_rad) * pose.vx_mps - std::sin(pose.yaw_rad) * pose.vy_mps,
+      std::sin(pose.yaw_rad) * pose.vx_mps + std::cos(pose.yaw_rad) * pose.vy_mps};
   in.t_s = now;
   in.changed_regions = &plan_changes_;
   core::plan::ExplorationResult r = policy_->plan(in);
@@ -455,21 +463,52 @@ void Autonomy::control_step() {
   }
   const LinkHealth link = platform_.link();
 
-  // Trajectory: a new one starts at the point nearest the robot within its first seconds (the
-  // robot kept moving while it was planned).
+  // Trajectory: a new one starts at the point nearest the robot within its first seconds
+  // (ControlLaw::entry_time). With plan.brake_start a moving robot first brakes on the trajectory
+  // it follows (the planner started the new one where that ends): braking straight off a curve
+  // while turning onto the new one swept the body into what the curve went round (house seed 3's
+  // railing, office seed 1's door frame, session 16).
+  const auto enter = [&](std::shared_ptr<const PlannedTrajectory> next) {
+    ctl_traj_ = std::move(next);
+    pending_.reset();
+    brake_k_ = 1.0;
+    entering_ = true;
+    if (ctl_traj_ && !ctl_traj_->trajectory.empty())
+      tau_ = ControlLaw::entry_time(ctl_traj_->trajectory,
+                                    Eigen::Vector2d(last_pose_.x_m, last_pose_.y_m));
+  };
   const auto tv = traj_.read();
   if (tv.version != ctl_traj_version_) {
     ctl_traj_version_ = tv.version;
-    ctl_traj_ = tv.ptr;
-    if (ctl_traj_ && !ctl_traj_->trajectory.empty()) {
-      const auto& t = ctl_traj_->trajectory;
-      double best = std::numeric_limits<double>::infinity();
-      tau_ = t.t_start();
-      for (double s = t.t_start(); s <= std::min(t.t_end(), t.t_start() + 2.0); s += 0.05) {
-        const double d = (t.sample(s).p_m - last_pose_.position()).head<2>().norm();
-        if (d < best) best = d, tau_ = s;
-      }
+    const double speed = std::hypot(last_pose_.vx_mps, last_pose_.vy_mps);
+    const double c = std::cos(last_pose_.yaw_rad), s = std::sin(last_pose_.yaw_rad);
+    const Eigen::Vector2d v(c * last_pose_.vx_mps - s * last_pose_.vy_mps,
+                            s * last_pose_.vx_mps + c * last_pose_.vy_mps);
+    const bool on_old =
+        ctl_traj_ && !ctl_traj_->trajectory.empty() &&
+        tau_ < std::min(ctl_traj_->trajectory.t_end(), ctl_traj_->real_until_s) &&
+        (ctl_traj_->trajectory.sample(tau_).p_m - last_pose_.position()).head<2>().norm() < 0.3;
+    // Only a trajectory the planner started where the braking ends: one starting on the old one
+    // ahead of the robot (a climb or a descent starts where the robot stood).
+    bool starts_ahead = false;
+    if (opt_.params.plan.brake_start && tv.ptr && !tv.ptr->trajectory.empty() && ctl_traj_ &&
+        (on_old || pending_)) {
+      const auto& old_t = ctl_traj_->trajectory;
+      const Eigen::Vector3d p0 = tv.ptr->trajectory.sample(tv.ptr->trajectory.t_start()).p_m;
+      for (double s = tau_ + 0.1; s <= std::min(old_t.t_end(), tau_ + 2.5) && !starts_ahead;
+           s += 0.05)
+        starts_ahead = (old_t.sample(s).p_m - p0).head<2>().norm() < 0.1;
     }
+    if (starts_ahead && speed > 0.2 && ControlLaw::turns_away(tv.ptr->trajectory, v)) {
+      if (!pending_) brake_k_ = 1.0, brake_v0_ = speed;
+      pending_ = tv.ptr;
+    } else {
+      enter(tv.ptr);
+    }
+  }
+  if (pending_) {
+    brake_k_ = std::max(0.0, brake_k_ - opt_.params.robot.max_accel_mps2 * dt / brake_v0_);
+    if (brake_k_ <= 0.0 || std::hypot(last_pose_.vx_mps, last_pose_.vy_mps) < 0.05) enter(pending_);
   }
   const bool has_traj = ctl_traj_ && !ctl_traj_->trajectory.empty();
   const double tau_end =
@@ -479,6 +518,7 @@ void Autonomy::control_step() {
   if (has_traj) {
     ref = ctl_traj_->trajectory.sample(std::min(tau_, tau_end));
     if (tau_ >= tau_end) ref.v_mps.setZero(), ref.yaw_rate_rps = 0;  // hold the end pose
+    ref.v_mps *= brake_k_, ref.yaw_rate_rps *= brake_k_;             // braking on it: slower
     err = (ref.p_m - last_pose_.position()).head<2>().norm();
   }
   const bool following = has_traj && (tau_ < tau_end || err > 0.15);
@@ -538,13 +578,14 @@ void Autonomy::control_step() {
 
   VelocityCommand cmd;
   if (!d.stop && following) {
-    cmd = law_.track(ref, last_pose_, prev_cmd_, dt);
+    entering_ = entering_ && law_.on_reference(ref, last_pose_) < 1.0;
+    cmd = law_.track(ref, last_pose_, prev_cmd_, dt, entering_);
     // Progress along the curve only while tracking well: after a stop or a lag the reference
     // waits for the robot instead of running away from it.
     const double yaw_err = std::abs(wrap_angle(ref.yaw_rad - last_pose_.yaw_rad));
     const double rate =
         std::clamp((0.6 - err) / 0.3, 0.0, 1.0) * std::clamp((1.2 - yaw_err) / 0.6, 0.0, 1.0);
-    tau_ = std::min(tau_ + dt * rate, tau_end);
+    tau_ = std::min(tau_ + dt * rate * brake_k_, tau_end);
   }
   // else: zero command (a stop is commanded in this very period; the robot's own deceleration
   // limits bring it to rest).

@@ -235,7 +235,12 @@ class Autonomy {
   core::plan::CollisionChecker lookahead_;
   uint64_t ctl_traj_version_ = 0, ctl_checked_traj_ = 0, ctl_checked_map_ = 0;
   std::shared_ptr<const PlannedTrajectory> ctl_traj_;
-  double tau_ = 0;  // progress along the trajectory [s] (advances while tracking well)
+  double tau_ = 0;         // progress along the trajectory [s] (advances while tracking well)
+  bool entering_ = false;  // a new trajectory the robot has not yet been on (turn_on_reference)
+  // plan.brake_start: a new trajectory waits while the robot brakes on the one it follows; the
+  // old one's progress and feedforward scaled by brake_k_, falling 1 -> 0 at a_max from brake_v0_.
+  std::shared_ptr<const PlannedTrajectory> pending_;
+  double brake_k_ = 1.0, brake_v0_ = 0;
   bool collision_predicted_ = false;
   VelocityCommand prev_cmd_;
   PoseSample last_pose_;

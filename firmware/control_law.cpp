@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace storey::firmware {
 
@@ -11,7 +12,7 @@ double wrap_angle(double a) {
 }
 
 VelocityCommand ControlLaw::track(const core::plan::TrajectorySample& ref, const PoseSample& pose,
-                                  const VelocityCommand& prev, double dt_s) const {
+                                  const VelocityCommand& prev, double dt_s, bool entering) const {
   // World-frame planar velocity: feedforward + P on the position error.
   const double wx = ref.v_mps.x() + gains_.k_position * (ref.p_m.x() - pose.x_m);
   const double wy = ref.v_mps.y() + gains_.k_position * (ref.p_m.y() - pose.y_m);
@@ -19,7 +20,7 @@ VelocityCommand ControlLaw::track(const core::plan::TrajectorySample& ref, const
   VelocityCommand cmd;
   cmd.vx_mps = c * wx + s * wy;  // rotate into the body frame
   cmd.vy_mps = -s * wx + c * wy;
-  cmd.yaw_rate_rps = (gains_.turn_on_reference ? on_reference(ref, pose) : 1.0) *
+  cmd.yaw_rate_rps = (gains_.turn_on_reference && entering ? on_reference(ref, pose) : 1.0) *
                      (ref.yaw_rate_rps + gains_.k_yaw * wrap_angle(ref.yaw_rad - pose.yaw_rad));
   return limit(cmd, prev, dt_s);
 }
@@ -60,13 +61,34 @@ double ControlLaw::on_reference(const core::plan::TrajectorySample& ref,
 
 double ControlLaw::braking_gap(const core::plan::TrajectorySample& ref,
                                const PoseSample& pose) const {
-  const double c = std::cos(pose.yaw_rad), s = std::sin(pose.yaw_rad);
-  const Eigen::Vector2d v(c * pose.vx_mps - s * pose.vy_mps, s * pose.vx_mps + c * pose.vy_mps);
   const Eigen::Vector2d vr = ref.v_mps.head<2>();
   const double two_a = 2.0 * std::max(robot_.max_accel_mps2, 1e-3);
-  return (Eigen::Vector2d(pose.x_m, pose.y_m) - ref.p_m.head<2>() +
-          (v * v.norm() - vr * vr.norm()) / two_a)
-      .norm();
+  return (rest_point(pose) - ref.p_m.head<2>() - vr * vr.norm() / two_a).norm();
+}
+
+Eigen::Vector2d ControlLaw::rest_point(const PoseSample& pose) const {
+  const double c = std::cos(pose.yaw_rad), s = std::sin(pose.yaw_rad);
+  const Eigen::Vector2d v(c * pose.vx_mps - s * pose.vy_mps, s * pose.vx_mps + c * pose.vy_mps);
+  const double two_a = 2.0 * std::max(robot_.max_accel_mps2, 1e-3);
+  return Eigen::Vector2d(pose.x_m, pose.y_m) + v * v.norm() / two_a;
+}
+
+bool ControlLaw::turns_away(const core::plan::BsplineTrajectory& t, const Eigen::Vector2d& v) {
+  if (t.empty() || v.norm() < 1e-6) return false;
+  const double t1 = std::min(t.t_end(), t.t_start() + 1.0);
+  const auto a = t.sample(t.t_start()), b = t.sample(t1);
+  if (std::abs(wrap_angle(b.yaw_rad - a.yaw_rad)) > 0.5) return true;
+  const Eigen::Vector2d d = (b.p_m - a.p_m).head<2>();
+  return d.norm() > 0.05 && d.normalized().dot(v.normalized()) < 0.5;
+}
+
+double ControlLaw::entry_time(const core::plan::BsplineTrajectory& t, const Eigen::Vector2d& at) {
+  double best = std::numeric_limits<double>::infinity(), tau = t.t_start();
+  for (double s = t.t_start(); s <= std::min(t.t_end(), t.t_start() + 2.0); s += 0.05) {
+    const double d = (t.sample(s).p_m.head<2>() - at).norm();
+    if (d < best) best = d, tau = s;
+  }
+  return tau;
 }
 
 }  // namespace storey::firmware

@@ -21,16 +21,30 @@ class ControlLaw {
       : robot_(robot), gains_(gains) {}
   // ref: the trajectory sample for now; pose: odometry; prev: the last command sent; dt_s: the
   // control period (bounds the change of the command by the acceleration limits).
-  // With ControlGains::turn_on_reference the yaw command is scaled by on_reference(): the robot
-  // turns only where it will come to rest on the reference.
+  // With ControlGains::turn_on_reference the yaw command is scaled by on_reference() while
+  // `entering` a new trajectory (until the robot first came to be on it): the robot turns only
+  // where it will come to rest on the reference. Once on it, full yaw authority (a robot lagging
+  // its reference on a flight, the gate held the yaw off the axis and the climbs failed).
   VelocityCommand track(const core::plan::TrajectorySample& ref, const PoseSample& pose,
-                        const VelocityCommand& prev, double dt_s) const;
+                        const VelocityCommand& prev, double dt_s, bool entering = true) const;
   // 1 while the point where the robot would stop if it braked now is within 0.15 m of the
   // reference's, falling to 0 at 0.3 m. A new trajectory starts at rest where the robot was when
   // it was planned; a robot arriving at walking speed overshoots that start by up to
   // v^2 / (2 a_max) (0.5 m at 1 m/s) before it is back, and turning the 0.7 m body there, off
   // the poses FCL checked, swept it into a door frame (teaching_building seed 1, 842 s).
   double on_reference(const core::plan::TrajectorySample& ref, const PoseSample& pose) const;
+  // Where the robot comes to rest if it brakes now at a_max, world frame [m] (planar).
+  Eigen::Vector2d rest_point(const PoseSample& pose) const;
+  // Where on a new trajectory tracking starts: its point nearest `at` within its first 2 s (the
+  // robot kept moving while it was planned). `at` is the robot, or with plan.brake_start its
+  // rest_point (the planner started the trajectory there: one that turns back passes the robot's
+  // position later, and tracking from there cut the turn short into a railing, house seed 2).
+  static double entry_time(const core::plan::BsplineTrajectory& t, const Eigen::Vector2d& at);
+  // A new trajectory that leaves its start more than 60 deg off the robot's velocity v (world
+  // frame), or turns the body more than 0.5 rad within its first second: the robot brakes on the
+  // trajectory it follows before it enters this one (plan.brake_start). One that carries on
+  // along v is entered at once (a stop at every replan would halve the speed).
+  static bool turns_away(const core::plan::BsplineTrajectory& t, const Eigen::Vector2d& v);
   // Clamps a command to speed / yaw-rate limits and rate-limits it against prev (exposed for
   // tests).
   VelocityCommand limit(VelocityCommand cmd, const VelocityCommand& prev, double dt_s) const;

@@ -189,6 +189,7 @@ ExplorationResult ExplorationPlanner::plan_cycle(const ExplorationInput& in) {
   li.viewpoints = in.viewpoints;
   li.robot_foot_m = in.robot_foot_m;
   li.robot_yaw_rad = in.robot_yaw_rad;
+  li.robot_velocity_mps = in.robot_velocity_mps;
   li.t_s = in.t_s;
   bool zones_left = false;
   // An escape or a climb under way is driven to its end before guidance picks a zone (a climb

@@ -333,7 +333,9 @@ bool LocalPlanner::free_start(const LocalPlanInput& in) {
   start_foot_m_ = in.robot_foot_m;
   start_yaw_ = in.robot_yaw_rad;
   BodyPose p{in.robot_foot_m, in.robot_yaw_rad, 0.0, in.t_s};
-  if (!checker_.check_poses(*in.view, std::span<const BodyPose>(&p, 1)).collides) return true;
+  const bool clear = !checker_.check_poses(*in.view, std::span<const BodyPose>(&p, 1)).collides;
+  if (clear && plan_opt_.brake_start) brake_start(in);
+  if (clear) return true;
   constexpr int kDirs = 16;
   constexpr double kYaws[] = {0.0, 0.3, -0.3, 0.6, -0.6, 1.2, -1.2, M_PI / 2, -M_PI / 2};
   double best = std::numeric_limits<double>::infinity();
@@ -355,6 +357,59 @@ bool LocalPlanner::free_start(const LocalPlanInput& in) {
         start_yaw_ = q.yaw_rad;
       }
   return std::isfinite(best);
+}
+
+// PlanOptions::brake_start: where a moving robot comes to rest, braking at the acceleration limit
+// (|v|^2 / (2 a_max) on): along the trajectory it follows (the control task brakes on it before
+// it enters a new one), else straight along its velocity. Taken as the start where the body is
+// clear every 0.05 m on the way (on the trajectory: its own poses; straight: the robot's yaw and
+// 0.6 rad either side), over no untraversable support.
+void LocalPlanner::brake_start(const LocalPlanInput& in) {
+  const Eigen::Vector2d v = in.robot_velocity_mps;
+  const double d = v.squaredNorm() / (2.0 * std::max(robot_.max_accel_mps2, 1e-3));
+  if (!std::isfinite(d) || d < 0.05) return;
+  std::vector<BodyPose> way;
+  // On the trajectory followed: from its point nearest the robot (within 0.3 m), d of arc on.
+  if (!current_.empty()) {
+    double s0 = NAN, best = 0.3;
+    for (double s = std::max(current_.t_start(), in.t_s - 2.0);
+         s <= std::min(current_.t_end(), in.t_s + 2.0); s += 0.02) {
+      const double e = (current_.sample(s).p_m - in.robot_foot_m).head<2>().norm();
+      if (e < best) best = e, s0 = s;
+    }
+    if (std::isfinite(s0)) {
+      double arc = 0, next = 0.05;
+      Eigen::Vector3d prev = current_.sample(s0).p_m;
+      for (double s = s0 + 0.02; s <= current_.t_end() + 1e-9 && arc < d; s += 0.02) {
+        const Eigen::Vector3d p = current_.sample(s).p_m;
+        arc += (p - prev).head<2>().norm();
+        prev = p;
+        if (arc >= next || arc >= d || s + 0.02 > current_.t_end()) {
+          BodyPose q = current_.pose(s);
+          q.t_s = in.t_s;
+          way.push_back(q);
+          next += 0.05;
+        }
+      }
+      if (way.empty() || checker_.check_poses(*in.view, way).collides) return;
+      start_foot_m_ = way.back().foot_m;
+      start_yaw_ = way.back().yaw_rad;
+      return;
+    }
+  }
+  const Eigen::Vector2d u = v.normalized();
+  double z = in.robot_foot_m.z();
+  for (double s = 0.05; s <= d + 1e-9; s += 0.05) {
+    const Eigen::Vector2d q = in.robot_foot_m.head<2>() + std::min(s, d) * u;
+    const auto sp = in.view->support_surface_near(
+        Eigen::Vector3f(float(q.x()), float(q.y()), float(z)), robot_.step_height_m);
+    if (sp && sp->state == map::TravState::kUntraversable) return;
+    if (sp) z = sp->height_m;  // else unseen (the LiDAR's blind ring): the robot goes there anyway
+    for (double dyaw : {0.0, -0.6, 0.6})
+      way.push_back(BodyPose{{q.x(), q.y(), z}, in.robot_yaw_rad + dyaw, 0.0, in.t_s});
+  }
+  if (way.empty() || checker_.check_poses(*in.view, way).collides) return;
+  start_foot_m_ = way.back().foot_m;
 }
 
 bool LocalPlanner::no_progress(const LocalPlanInput& in) {
@@ -541,6 +596,9 @@ bool LocalPlanner::climb_on(const LocalPlanInput& in, LocalPlanResult& out, bool
   // From a flight's foot: the floor up to the first riser is walked level (often unseen: the
   // LiDAR's blind ring where the robot stood to see the flight), and a tread unseen across the
   // line leaves the next one two steps up: past a gap, support up to a 40 deg grade is taken.
+  // With flight_foot the same on the flight (a tread below checked above): pitched up, the LiDAR
+  // looks over the next treads (house seed 6: a climb stopped mid-flight by the look-ahead found
+  // nothing ahead within a step and the robot stood there until "complete").
   const double s_riser = given ? (given->riser_m.head<2>() - o).dot(axis->dir)
                                : -std::numeric_limits<double>::infinity();
   for (double s = vs; s <= 8.0 && gap <= 0.45; s += vs) {
@@ -549,7 +607,8 @@ bool LocalPlanner::climb_on(const LocalPlanInput& in, LocalPlanResult& out, bool
       pts.emplace_back(q.x(), q.y(), foot.z());
       continue;
     }
-    const double rise = given ? step + 0.84 * gap : step;
+    const double rise =
+        given || (on_flight_only && plan_opt_.flight_foot) ? step + 0.84 * gap : step;
     const auto sp = view.support_surface_near(
         Eigen::Vector3f(float(q.x()), float(q.y()), float(z + 0.5 * rise)), 0.5 * rise + 0.03);
     if (sp && sp->height_m >= z - 0.03) {
@@ -844,12 +903,16 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   if (has_target_) {
     const graph::FrontierCluster* tc = track_target(in);
     const double dxy = (in.robot_foot_m - target_m_).head<2>().norm();
-    // A flight's foot is reached where the climb can start: on it, or a second after the
-    // trajectory's end (the robot trails its reference).
-    const bool reached = (flight_target ? dxy <= 0.15 || (in.t_s >= current_.t_end() + 1.0 &&
-                                                          dxy <= opt_.reached_radius_m)
-                                        : dxy <= opt_.reached_radius_m) &&
-                         std::abs(in.robot_foot_m.z() - target_m_.z()) < 0.5;
+    // A flight's foot (and with flight_foot the foot of a climb left for last) is reached where
+    // the climb can start: on it, or a second after the trajectory's end (the robot trails its
+    // reference). (Back at a climb left for last "reached" 0.42 m short, 0.74 m before the first
+    // riser, the climb found no flight ahead and the upper floor was never explored: house seed 9
+    // with flight_foot, session 16.)
+    const bool at_foot = flight_target || (climb_start_ && plan_opt_.flight_foot);
+    const bool reached =
+        (at_foot ? dxy <= 0.15 || (in.t_s >= current_.t_end() + 1.0 && dxy <= opt_.reached_radius_m)
+                 : dxy <= opt_.reached_radius_m) &&
+        std::abs(in.robot_foot_m.z() - target_m_.z()) < 0.5;
     // An escape or a climb runs to its end (a climb stopped half a metre short of its landing
     // leaves the body's rear over the flight).
     if (committed_ && (in.t_s >= current_.t_end() || dxy <= 0.1)) {
@@ -1231,8 +1294,15 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   for (const Failed& f : failed)
     hits_near = hits_near && from_start_m(f.hit_m) <= 2.5 &&
                 f.hit_m.z() < in.robot_foot_m.z() + robot_.step_height_m;
-  if ((boxed_in || hits_near) && plan_opt_.climb_blind && descents_ < 2 &&
-      descend_flight(in, out)) {
+  // With flight_foot not with a target on the robot's own level (test_stair seed 3, session 16:
+  // boxed in on the landing with a frontier of the upper floor beside it, the robot walked down
+  // to the floor and the upper floor was left at 13 %).
+  bool off_level = !failed.empty();
+  for (const Failed& f : failed)
+    off_level = off_level && std::abs(g.node(sel[order[f.m]].rep).p_m.z() - in.robot_foot_m.z()) >
+                                 robot_.step_height_m;
+  if ((boxed_in || hits_near) && (off_level || !plan_opt_.flight_foot) && plan_opt_.climb_blind &&
+      descents_ < 2 && descend_flight(in, out)) {
     ++descents_;
     return commit("descend: boxed in on a flight, straight down its axis to the floor below");
   }

@@ -50,7 +50,8 @@ struct LocalPlanInput {
   const std::vector<graph::ClusterViewpoints>* viewpoints = nullptr;
   Eigen::Vector3d robot_foot_m = Eigen::Vector3d::Zero();  // ground point under the robot [m]
   double robot_yaw_rad = 0;
-  double t_s = 0;                           // now, on the trajectory's time base [s]
+  double t_s = 0;  // now, on the trajectory's time base [s]
+  Eigen::Vector2d robot_velocity_mps = Eigen::Vector2d::Zero();  // planar, world frame [m/s]
   std::optional<Eigen::Vector3d> anchor_m;  // c_anc from the macro layer (Stage 1 terminal)
   // The last call of a cycle, over every cluster: with nothing else left, clusters set aside for
   // a path failure may be retried from a new vantage point (PlanOptions::path_retries).
@@ -223,6 +224,7 @@ class LocalPlanner {
   // PlanOptions::no_progress_s: true once the robot stood that long with a target (then the
   // clock starts again).
   bool no_progress(const LocalPlanInput& in);
+  void brake_start(const LocalPlanInput& in);  // PlanOptions::brake_start: moves start_foot_m_
   // The nearest occupied voxel in the body's height band within 0.6 m of the robot, else the
   // point 0.45 m ahead of it: what a body that does not move meets.
   Eigen::Vector3f blocking_point(const LocalPlanInput& in) const;

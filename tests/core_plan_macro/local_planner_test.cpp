@@ -613,3 +613,85 @@ TEST(LocalPlanner, BoxedInOnAFlightWalksStraightDownItsAxisToTheFloor) {
   }
   EXPECT_TRUE(descended);
 }
+
+// On a flight the LiDAR, pitched up with the body, looks over the next treads: a tread ahead is
+// often missing from the map and the one after it is two steps up. With flight_foot the climb on
+// from mid-flight bridges such a gap as it does from the foot (house seed 6, session 16: a climb
+// stopped on the flight by the look-ahead found nothing within a step ahead, and the robot stood
+// there until "complete" with the upper floor at 1.5 %). Without: it stays.
+TEST(LocalPlanner, WithFlightFootTheClimbOnBridgesATreadMissingFromTheMapOnTheFlight) {
+  Harness h;
+  const World w = flight_to_landing();
+  // Seen from the floor (the risers) and from 2 m up (the treads' tops); the third tread (x
+  // 0.6-0.9: the LiDAR's blind ring) and the landing (past x 2.1) not in the map.
+  uint32_t seed = 1;
+  for (const float up : {0.5f, 2.0f})
+    for (const Eigen::Vector3f& f :
+         {Eigen::Vector3f(-1.5f, 0.4f, 0), Eigen::Vector3f(-1.5f, -0.4f, 0)}) {
+      std::vector<Eigen::Vector3f> pts;
+      const Eigen::Vector3f s = f + Eigen::Vector3f(0, 0, up);
+      for (const Eigen::Vector3f& p : storey::test::macro::scan(w, s, 100000, seed++))
+        if (p.x() < 2.05f && !(p.x() > 0.58f && p.x() < 0.92f)) pts.push_back(p);
+      h.insert(s, pts, f);
+    }
+  const auto view = h.map.view();
+  const std::vector<storey::core::graph::FrontierCluster> none;
+  auto plan_on_tread_2 = [&](bool flight_foot) {
+    PlanOptions po;
+    po.climb_blind = true;
+    po.flight_foot = flight_foot;
+    LocalPlanner lp(RobotModel{}, po, 0.1);
+    LocalPlanInput in = input(h, view, {0.45f, 0, 0.3f}, 0.0);  // on the second tread, facing up
+    in.clusters = &none;
+    in.last_resort = true;
+    return lp.plan(in);
+  };
+  const LocalPlanResult r = plan_on_tread_2(true);
+  ASSERT_EQ(r.status, LocalPlanStatus::kNewTrajectory) << r.replan_reason;
+  EXPECT_EQ(std::string(r.replan_reason).rfind("climb on", 0), 0u) << r.replan_reason;
+  const auto end = r.trajectory.pose(r.trajectory.t_end());
+  EXPECT_NEAR(end.foot_m.z(), 1.05, 0.06) << end.foot_m.transpose();  // up to the top tread
+  EXPECT_NEAR(end.foot_m.y(), 0.0, 0.15) << end.foot_m.transpose();   // along the axis
+  const LocalPlanResult off = plan_on_tread_2(false);
+  EXPECT_NE(std::string(off.replan_reason).rfind("climb on", 0), 0u) << off.replan_reason;
+}
+
+// PlanOptions::brake_start: a robot moving when Stage 3 plans comes to rest |v|^2 / (2 a_max)
+// further on before it follows the new trajectory (the control task's acceleration limit); the
+// trajectory starts there where the way is clear (house seed 3, session 16: a new target behind
+// the robot, the body turned while overshooting its start into a railing), else where it stands.
+namespace {
+Eigen::Vector3d planned_start(bool brake, const Eigen::Vector3f& foot, const Eigen::Vector2d& v) {
+  Harness h;
+  const World w = corridor();
+  EXPECT_TRUE(scan_from(h, w, Eigen::Vector3f::Zero()));
+  PlanOptions po;
+  po.brake_start = brake;
+  LocalPlanner lp(RobotModel{}, po, 0.1);
+  const auto view = h.map.view();
+  LocalPlanInput in = input(h, view, foot, 0.0);
+  in.robot_velocity_mps = v;
+  const LocalPlanResult r = lp.plan(in);
+  EXPECT_EQ(r.status, LocalPlanStatus::kNewTrajectory) << r.replan_reason;
+  if (r.status != LocalPlanStatus::kNewTrajectory) return Eigen::Vector3d::Constant(NAN);
+  return r.trajectory.pose(r.trajectory.t_start()).foot_m;
+}
+}  // namespace
+
+TEST(LocalPlanner, AMovingRobotsTrajectoryStartsWhereItComesToRest) {
+  const RobotModel robot;
+  const Eigen::Vector2d v(0.8, 0.0);  // along the corridor: 0.32 m to rest at 1 m/s^2
+  const double d = v.squaredNorm() / (2 * robot.max_accel_mps2);
+  const Eigen::Vector3d on = planned_start(true, {0, 0, 0}, v);
+  EXPECT_NEAR(on.x(), d, 0.03) << on.transpose();
+  EXPECT_NEAR(on.y(), 0.0, 0.03) << on.transpose();
+  const Eigen::Vector3d off = planned_start(false, {0, 0, 0}, v);
+  EXPECT_NEAR(off.head<2>().norm(), 0.0, 0.03) << off.transpose();
+  // Toward the wall 0.8 m away at 1 m/s (0.5 m to rest): the body, turning, would meet it on the
+  // way; the start stays.
+  const Eigen::Vector3d wall = planned_start(true, {0, 2.2f, 0}, {0.0, 1.0});
+  EXPECT_NEAR(wall.y(), 2.2, 0.03) << wall.transpose();
+  // Standing still: where it stands.
+  const Eigen::Vector3d still = planned_start(true, {0, 0, 0}, {0.0, 0.0});
+  EXPECT_NEAR(still.head<2>().norm(), 0.0, 0.03) << still.transpose();
+}

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 #include "firmware/control_law.hpp"
 #include "firmware/safety_monitor.hpp"
@@ -79,6 +80,47 @@ TEST(ControlLaw, TurnsOnlyWhereItWillComeToRestOnTheReference) {
   PoseSample moving;
   moving.vx_mps = 0.9;
   EXPECT_EQ(law.on_reference(ref_at(0.05, 0, 0.9, 0, 0), moving), 1.0);
+  // Once the robot has been on the trajectory (not `entering` it), a lag does not gate the yaw
+  // (on a flight the robot trails its reference; gated, it drifted off the axis).
+  PoseSample lagging;
+  lagging.x_m = -0.5;
+  EXPECT_EQ(law.track(start, lagging, VelocityCommand{}, dt, true).yaw_rate_rps, 0.0);
+  EXPECT_GT(law.track(start, lagging, VelocityCommand{}, dt, false).yaw_rate_rps, 0.0);
+}
+
+// plan.brake_start: the planner starts a moving robot's new trajectory where it comes to rest.
+// Tracking enters a trajectory at its point nearest the robot within its first 2 s; nearest the
+// rest point, that is its start. A trajectory that starts there and turns back passes the
+// robot's own position later: entered there, its turn at the start was cut short (house seed 2,
+// session 16: the body swept into the stairwell's railing).
+TEST(ControlLaw, ANewTrajectoryIsEnteredNearestWhereTheRobotComesToRest) {
+  core::RobotModel robot;
+  ControlLaw law(robot);
+  PoseSample pose;
+  pose.yaw_rad = M_PI / 2;
+  pose.vx_mps = 0.8;  // body forward = world +y
+  const Eigen::Vector2d rest = law.rest_point(pose);
+  EXPECT_NEAR(rest.x(), 0.0, 1e-9);
+  EXPECT_NEAR(rest.y(), 0.8 * 0.8 / (2 * robot.max_accel_mps2), 1e-9);
+  // From the rest point (0, 0.32) back through the robot's position (0, 0) to (0, -1.5), 1 s per
+  // knot: the start at rest, the robot's position passed about 1 s in.
+  std::vector<Eigen::Vector3d> ctrl;
+  for (double y : {0.32, 0.32, 0.32, 0.0, -0.5, -1.0, -1.5, -1.5, -1.5})
+    ctrl.emplace_back(0.0, y, 0.0);
+  const core::plan::BsplineTrajectory t(ctrl, std::vector<double>(ctrl.size(), M_PI / 2), 1.0,
+                                        10.0);
+  EXPECT_NEAR(ControlLaw::entry_time(t, rest), 10.0, 0.05);
+  EXPECT_GT(ControlLaw::entry_time(t, {pose.x_m, pose.y_m}), 10.5);
+  // It leaves its start against the robot's velocity: the robot brakes on the trajectory it
+  // follows first. One carrying on along the velocity is entered at once; one turning the body
+  // in place at its start is not.
+  EXPECT_TRUE(ControlLaw::turns_away(t, {0.0, 0.8}));
+  EXPECT_FALSE(ControlLaw::turns_away(t, {0.0, -0.8}));
+  EXPECT_FALSE(ControlLaw::turns_away(t, {0.3, -0.8}));
+  std::vector<double> turning(ctrl.size(), M_PI / 2);
+  turning[2] = turning[3] = turning[4] = -0.5;
+  const core::plan::BsplineTrajectory turn(ctrl, turning, 1.0, 10.0);
+  EXPECT_TRUE(ControlLaw::turns_away(turn, {0.0, -0.8}));
 }
 
 TEST(ControlLaw, FeedforwardInBodyFrameAndNanGuard) {
