@@ -300,9 +300,7 @@ void Autonomy::plan_step() {
   in.viewpoints = &w.viewpoints;
   in.robot_foot_m = pose.position();
   in.robot_yaw_rad = pose.yaw_rad;
-  in.robot_velocity_mps = {
-      std::cos(pose.yaw_rad) * pose.vx_mps - std::sin(pose.yaw_rad) * pose.vy_mps,
-      std::sin(pose.yaw_rad) * pose.vx_mps + std::cos(pose.yaw_rad) * pose.vy_mps};
+  in.robot_velocity_mps = pose.velocity_world();
   in.t_s = now;
   in.changed_regions = &plan_changes_;
   core::plan::ExplorationResult r = policy_->plan(in);
@@ -467,7 +465,7 @@ void Autonomy::control_step() {
   // (ControlLaw::entry_time). With plan.brake_start a moving robot first brakes on the trajectory
   // it follows (the planner started the new one where that ends): braking straight off a curve
   // while turning onto the new one swept the body into what the curve went round (house seed 3's
-  // railing, office seed 1's door frame, session 16).
+  // railing, session 16).
   const auto enter = [&](std::shared_ptr<const PlannedTrajectory> next) {
     ctl_traj_ = std::move(next);
     pending_.reset();
@@ -480,27 +478,24 @@ void Autonomy::control_step() {
   const auto tv = traj_.read();
   if (tv.version != ctl_traj_version_) {
     ctl_traj_version_ = tv.version;
-    const double speed = std::hypot(last_pose_.vx_mps, last_pose_.vy_mps);
-    const double c = std::cos(last_pose_.yaw_rad), s = std::sin(last_pose_.yaw_rad);
-    const Eigen::Vector2d v(c * last_pose_.vx_mps - s * last_pose_.vy_mps,
-                            s * last_pose_.vx_mps + c * last_pose_.vy_mps);
-    const bool on_old =
-        ctl_traj_ && !ctl_traj_->trajectory.empty() &&
-        tau_ < std::min(ctl_traj_->trajectory.t_end(), ctl_traj_->real_until_s) &&
-        (ctl_traj_->trajectory.sample(tau_).p_m - last_pose_.position()).head<2>().norm() < 0.3;
+    const Eigen::Vector2d v = last_pose_.velocity_world();
     // Only a trajectory the planner started where the braking ends: one starting on the old one
-    // ahead of the robot (a climb or a descent starts where the robot stood).
+    // (followed, or already braked on) ahead of the robot (a climb or a descent starts where the
+    // robot stood).
     bool starts_ahead = false;
     if (opt_.params.plan.brake_start && tv.ptr && !tv.ptr->trajectory.empty() && ctl_traj_ &&
-        (on_old || pending_)) {
+        !ctl_traj_->trajectory.empty()) {
       const auto& old_t = ctl_traj_->trajectory;
+      const bool on_old = tau_ < std::min(old_t.t_end(), ctl_traj_->real_until_s) &&
+                          (old_t.sample(tau_).p_m - last_pose_.position()).head<2>().norm() < 0.3;
       const Eigen::Vector3d p0 = tv.ptr->trajectory.sample(tv.ptr->trajectory.t_start()).p_m;
-      for (double s = tau_ + 0.1; s <= std::min(old_t.t_end(), tau_ + 2.5) && !starts_ahead;
+      for (double s = tau_ + 0.1;
+           (on_old || pending_) && s <= std::min(old_t.t_end(), tau_ + 2.5) && !starts_ahead;
            s += 0.05)
         starts_ahead = (old_t.sample(s).p_m - p0).head<2>().norm() < 0.1;
     }
-    if (starts_ahead && speed > 0.2 && ControlLaw::turns_away(tv.ptr->trajectory, v)) {
-      if (!pending_) brake_k_ = 1.0, brake_v0_ = speed;
+    if (starts_ahead && v.norm() > 0.2 && ControlLaw::turns_away(tv.ptr->trajectory, v)) {
+      if (!pending_) brake_k_ = 1.0, brake_v0_ = v.norm();
       pending_ = tv.ptr;
     } else {
       enter(tv.ptr);

@@ -67,8 +67,7 @@ double ControlLaw::braking_gap(const core::plan::TrajectorySample& ref,
 }
 
 Eigen::Vector2d ControlLaw::rest_point(const PoseSample& pose) const {
-  const double c = std::cos(pose.yaw_rad), s = std::sin(pose.yaw_rad);
-  const Eigen::Vector2d v(c * pose.vx_mps - s * pose.vy_mps, s * pose.vx_mps + c * pose.vy_mps);
+  const Eigen::Vector2d v = pose.velocity_world();
   const double two_a = 2.0 * std::max(robot_.max_accel_mps2, 1e-3);
   return Eigen::Vector2d(pose.x_m, pose.y_m) + v * v.norm() / two_a;
 }

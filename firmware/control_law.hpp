@@ -35,10 +35,11 @@ class ControlLaw {
   double on_reference(const core::plan::TrajectorySample& ref, const PoseSample& pose) const;
   // Where the robot comes to rest if it brakes now at a_max, world frame [m] (planar).
   Eigen::Vector2d rest_point(const PoseSample& pose) const;
-  // Where on a new trajectory tracking starts: its point nearest `at` within its first 2 s (the
-  // robot kept moving while it was planned). `at` is the robot, or with plan.brake_start its
-  // rest_point (the planner started the trajectory there: one that turns back passes the robot's
-  // position later, and tracking from there cut the turn short into a railing, house seed 2).
+  // Where on a new trajectory tracking starts: its point nearest `at` (the robot) within its first
+  // 2 s (the robot kept moving while it was planned). With plan.brake_start the control task
+  // enters a trajectory that turns away only once braked to rest on the old one, where the
+  // planner started it: entered while moving, a trajectory that turns back passes the robot's
+  // position later, and tracking from there cut the turn short into a railing (house seed 2).
   static double entry_time(const core::plan::BsplineTrajectory& t, const Eigen::Vector2d& at);
   // A new trajectory that leaves its start more than 60 deg off the robot's velocity v (world
   // frame), or turns the body more than 0.5 rad within its first second: the robot brakes on the

@@ -4,6 +4,7 @@
 // lockstep simulator implements it in tools/sim/sim_platform.hpp; the live robot (drivers/lidar +
 // drivers/go2) will implement it for `storey run`. Times are seconds on the firmware clock's
 // timeline (the scheduler's clock: virtual in sim, monotonic live).
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -31,6 +32,10 @@ struct PoseSample {
   double yaw_rad = 0;
   double vx_mps = 0, vy_mps = 0, yaw_rate_rps = 0;  // body frame
   Eigen::Vector3d position() const { return {x_m, y_m, z_m}; }
+  Eigen::Vector2d velocity_world() const {  // planar velocity, body -> world frame
+    const double c = std::cos(yaw_rad), s = std::sin(yaw_rad);
+    return {c * vx_mps - s * vy_mps, s * vx_mps + c * vy_mps};
+  }
 };
 
 // Body-frame velocity command (x forward, y left) [m/s], yaw rate [rad/s].

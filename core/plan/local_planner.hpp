@@ -248,11 +248,11 @@ class LocalPlanner {
                       LocalPlanResult& out);
   // Stage 3 to f's stand point, else up to 0.75 m farther back on the axis (room to turn).
   bool to_foot_of(const LocalPlanInput& in, const FlightFoot& f, LocalPlanResult& out);
-  // A straight walk at constant yaw through `pts` (foot points), checked against the map.
   // Boxed in on a flight (every Stage 3 body hit next to the start): straight down the flight's
   // axis over the support the map holds to the floor below, facing whichever way along the axis
   // the robot faces (see local_planner.cpp).
   bool descend_flight(const LocalPlanInput& in, LocalPlanResult& out);
+  // A straight walk at constant yaw through `pts` (foot points), checked against the map.
   bool straight_walk(const LocalPlanInput& in, const std::vector<Eigen::Vector3d>& pts, double yaw,
                      LocalPlanResult& out);
   void take_walk(StraightWalk&& w, double yaw, LocalPlanResult& out);

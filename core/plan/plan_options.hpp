@@ -77,10 +77,10 @@ struct PlanOptions {
   // 6 and 7 (docs/RESULTS.md session 13).
   bool flight_foot = false;
   // Beyond the paper (session 16): a robot moving when Stage 3 plans comes to rest |v|^2 / (2
-  // a_max) further on (the control task's acceleration limit) before it follows the new
-  // trajectory, turning meanwhile; the new trajectory starts there, where the braking path is
-  // clear (house seed 3: a new target behind the robot, the body turned while overshooting its
-  // start into the stairwell's railing).
+  // a_max) further on (the control task's acceleration limit), on the trajectory it follows; the
+  // new trajectory starts there, where the braking path is clear, and the control task brakes on
+  // the old one before entering a new one that turns away (house seed 3: a new target behind the
+  // robot, the body turned while overshooting its start into the stairwell's railing).
   bool brake_start = false;
   bool incremental_maintenance = true;
 };
