@@ -150,30 +150,6 @@ void Autonomy::ingest_step() {
   }
 }
 
-namespace {
-// Ground observed more than a step under a foot-height point, within a metre: the point lies over
-// a drop or the treads of a flight going down, not on the floor the robot stands on.
-bool below_foot(const core::map::MapView& view, const Eigen::Vector3f& p) {
-  const float vs = float(view.voxel_size_m());
-  for (float dz = float(view.robot().step_height_m) + vs; dz <= 1.0f; dz += vs)
-    if (view.is_occupied(view.key_of(p - Eigen::Vector3f(0, 0, dz)))) return true;
-  return false;
-}
-
-// Share of the columns within 0.5 m of the foot that hold support at its height.
-float support_fraction(const core::map::MapView& view, const Eigen::Vector3f& foot) {
-  const float vs = float(view.voxel_size_m());
-  int n = 0, with = 0;
-  for (float x = -0.5f; x <= 0.5f + 1e-4f; x += vs)
-    for (float y = -0.5f; y <= 0.5f + 1e-4f; y += vs) {
-      if (x * x + y * y > 0.25f + 1e-4f) continue;
-      ++n;
-      with += view.support_surface_near(foot + Eigen::Vector3f(x, y, 0), 0.15).has_value();
-    }
-  return n ? float(with) / float(n) : 1.0f;
-}
-}  // namespace
-
 // ---- map + graph (10 Hz): insert scans, traversability, C_reach, G_real, frontiers, clusters,
 // viewpoints; publish the world model.
 void Autonomy::map_step() {
@@ -188,19 +164,29 @@ void Autonomy::map_step() {
   PoseSample pose;
   if (pose_mb_.read(pose) == 0) return;  // no odometry yet: C_reach needs the robot's foot
   const Eigen::Vector3f foot = pose.position().cast<float>();
+  level_.update(foot);
+  // The plan task saw a blind climb end on its landing (LocalPlanner::landings()).
+  const bool landed = landed_request_.exchange(false, std::memory_order_acq_rel);
   if (!startup_support_done_ && scans_inserted_ > 0) {
     startup_support_done_ = true;
     startup_points_ = insert_startup_support(foot);
   } else if (opt_.params.plan.climb_blind && scans_inserted_ > 0 &&
-             ((foot - last_support_foot_).norm() > 1.0f ||
-              (opt_.params.plan.flight_foot && std::abs(foot.z() - last_support_foot_.z()) >
-                                                   float(opt_.params.robot.step_height_m))) &&
+             (opt_.params.plan.flight_foot
+                  ? (level_.level() || landed) &&
+                        ((foot - last_support_foot_).norm() > 1.0f ||
+                         std::abs(foot.z() - last_support_foot_.z()) > LevelTracker::kTolM)
+                  : (foot - last_support_foot_).norm() > 1.0f) &&
              support_fraction(map_.view(), foot) < 0.5f) {
     // Stepped onto ground the LiDAR has not seen (a landing reached blind from a flight, whose
     // pitch kept the LiDAR looking over it): the legs stand on it, enter it as well. Once per
-    // metre; with plan.flight_foot also per level: entered on the top tread, the landing 0.94 m
-    // on and a step up was not (house seed 8, session 16: no node grew on the upper floor,
-    // "complete" with it at 10 %).
+    // metre; with plan.flight_foot on every new level too, but only where the robot walks level
+    // or a climb has just ended on its landing: entered on the top tread, the landing 0.94 m on
+    // and a step up was not (house seed 8, session 16: no node grew on the upper floor,
+    // "complete" with it at 10 %); entered on the top tread while climbing, the disc laid the
+    // landing 0.17 m low (test_stair seed 2, session 17: every trajectory onto it pitched the
+    // body into the railing). A climb ends as little as 0.07 m past the top riser (house seed 4),
+    // and a robot stopped mid-flight stands as still as one on its landing (office seed 2: a disc
+    // at z 1.0 over the treads, the flight never found again).
     insert_startup_support(foot);
   }
   map_.update_traversability();
@@ -242,29 +228,17 @@ void Autonomy::map_step() {
   world_.publish(std::shared_ptr<const WorldModel>(std::move(w)));
 }
 
-// Start-up support (once): the robot stands on ground its LiDAR cannot see (the blind ring of
-// radius h / tan(-v_min) around it). Its legs measure that ground, so the firmware enters it as
-// observed support: points at foot height on a 3.3 cm grid within the blind radius, each kept
-// only if the line of sight from the sensor to it is free in the first scans (walls and drops
-// already seen clip it). Without it a VLP-16 in a 2 m corridor sees no floor to start from.
+// Start-up support (once, and with plan.climb_blind on unseen ground): blind_support.hpp. The
+// radius is capped at the blind radius + 0.3 m.
 size_t Autonomy::insert_startup_support(const Eigen::Vector3f& foot) {
   last_support_foot_ = foot;
   const double down = -opt_.fov.v_min_deg * M_PI / 180.0;
   if (down <= 0.01 || opt_.startup_support_radius_m <= 0) return 0;
-  const float r = float(
-      std::min(opt_.startup_support_radius_m, opt_.fov.mount_height_m / std::tan(down) + 0.3));
+  const double r =
+      std::min(opt_.startup_support_radius_m, opt_.fov.mount_height_m / std::tan(down) + 0.3);
+  const std::vector<Eigen::Vector3f> pts =
+      blind_support_points(map_.view(), foot, opt_.fov.mount_height_m, r);
   const Eigen::Vector3f origin = foot + Eigen::Vector3f(0, 0, float(opt_.fov.mount_height_m));
-  const core::map::MapView view = map_.view();
-  std::vector<Eigen::Vector3f> pts;
-  const float step = 0.033f;
-  for (float x = -r; x <= r; x += step)
-    for (float y = -r; y <= r; y += step) {
-      if (x * x + y * y > r * r) continue;
-      const Eigen::Vector3f p = foot + Eigen::Vector3f(x, y, -0.01f);
-      if (view.first_occupied(origin, p + Eigen::Vector3f(0, 0, 0.12f))) continue;
-      if (below_foot(view, p)) continue;
-      pts.push_back(p);
-    }
   map_.insert_scan(origin, pts);
   changed_.push_back(core::graph::scan_bounds(origin, pts));
   return pts.size();
@@ -304,6 +278,11 @@ void Autonomy::plan_step() {
   in.t_s = now;
   in.changed_regions = &plan_changes_;
   core::plan::ExplorationResult r = policy_->plan(in);
+  if (const core::plan::LocalPlanner* l = policy_->local_layer();
+      l && l->landings() != landings_seen_) {
+    landings_seen_ = l->landings();
+    landed_request_.store(true, std::memory_order_release);
+  }
 
   using PS = core::plan::ExplorationStatus;
   auto publish = [&](std::shared_ptr<PlannedTrajectory> p) {

@@ -32,6 +32,7 @@
 #include "core/map/traversability_map.hpp"
 #include "core/plan/collision_checker.hpp"
 #include "core/plan/local_planner.hpp"
+#include "firmware/blind_support.hpp"
 #include "firmware/control_law.hpp"
 #include "firmware/exploration_policy.hpp"
 #include "firmware/platform.hpp"
@@ -207,6 +208,7 @@ class Autonomy {
   uint64_t map_cycle_ = 0, scans_inserted_ = 0;
   bool startup_support_done_ = false;
   Eigen::Vector3f last_support_foot_ = Eigen::Vector3f::Constant(1e9f);  // last insertion
+  LevelTracker level_;  // with plan.flight_foot, blind-ring support only where it walks level
   size_t startup_points_ = 0;
   rt::Snapshot<WorldModel> world_;
 
@@ -225,6 +227,8 @@ class Autonomy {
   rt::Mailbox<double> plan_alive_mb_;
   rt::Mailbox<ExplorationStatus> status_mb_;
   std::atomic<bool> replan_request_{false};  // control -> plan: drop the current target
+  std::atomic<bool> landed_request_{false};  // plan -> map: a climb ended on its landing
+  uint64_t landings_seen_ = 0;               // plan task: LocalPlanner::landings() last seen
   uint64_t traj_id_ = 0, plan_cycles_ = 0, trajectories_ = 0;
   double idle_since_s_ = -1;
   bool complete_ = false;

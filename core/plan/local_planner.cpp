@@ -1001,6 +1001,12 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   out.replan_reason = reason;
   climb_start_ = false;
   if (retrying_) release_retry();  // the retry move ended: plan from the new vantage point
+  // A climb (not a partial one) that ended at its planned height: the robot stands on the
+  // landing it walked onto blind (landings()), also from a top tread level with it.
+  if (climbing_ && !climb_partial_ &&
+      std::abs(in.robot_foot_m.z() - current_.pose(current_.t_end()).foot_m.z()) <
+          0.5 * robot_.step_height_m)
+    ++landings_;
   // A climb dropped before the robot left the floor it started on (a collision predicted at the
   // foot) climbed nothing: with flight_foot it is not recorded (recorded, its flight's frontiers
   // up to the planned landing were ignored for good: house seed 1, session 14).

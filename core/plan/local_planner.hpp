@@ -172,6 +172,10 @@ class LocalPlanner {
   uint64_t no_progress_events() const { return no_progress_events_; }  // PlanOptions::no_progress_s
   size_t set_aside_nodes() const { return set_aside_.size(); }
   uint64_t set_aside_expired() const { return expired_total_; }  // since construction
+  // Blind climbs that ended with the robot on their landing, within half a step of its planned
+  // height (not partial, not dropped on the flight); since construction. The LiDAR never saw
+  // that ground: the firmware enters it as support under the legs (firmware/blind_support.hpp).
+  uint64_t landings() const { return landings_; }
   // Diagnostics: the set-aside frontier nodes with their reasons; the entry of the set-aside
   // node nearest p (within set_aside_radius_m), or nullptr.
   const std::vector<SetAsideEntry>& set_aside() const { return set_aside_; }
@@ -314,6 +318,7 @@ class LocalPlanner {
   bool climb_start_ = false;
   bool climbing_ = false;     // the committed move is a climb
   double climb_done_s_ = -1;  // when the last climb ended
+  uint64_t landings_ = 0;     // see landings()
   FlightAxis climb_axis_;     // climb_on's last axis (origin: the walk's foot on it)
   FlightAxis climbing_axis_;  // the committed climb's axis
   // No-progress watchdog: where and when the robot last moved (PlanOptions::no_progress_s).

@@ -491,6 +491,7 @@ TEST(LocalPlanner, APartialClimbsEndOnTheTopTreadWalksOnOntoALandingSeenOnlyFrom
     EXPECT_LE(top.x(), 2.1) << top.transpose();
     // Nothing observed over the landing: no walk onto it.
     EXPECT_FALSE(run(view, 4).allFinite());
+    EXPECT_EQ(lp.landings(), 0u) << "a partial climb ends on the top tread, not on a landing";
   }
   // The pitched body's scan from the top tread: rays 12-42 deg up only.
   h.observe(w, foot, 40000, 4, 0.21f, 0.73f);
@@ -500,6 +501,9 @@ TEST(LocalPlanner, APartialClimbsEndOnTheTopTreadWalksOnOntoALandingSeenOnlyFrom
   EXPECT_NEAR(on.z(), 1.05, 0.06) << on.transpose();
   EXPECT_GE(on.x(), 2.1 + 0.2) << on.transpose();   // on the landing
   EXPECT_LE(on.x(), 3.35 - 0.3) << on.transpose();  // the body short of its wall
+  // Once that walk has ended, the robot stands on the landing: the firmware enters its ground.
+  run(view, 1);
+  EXPECT_EQ(lp.landings(), 1u);
 }
 
 // PlanOptions::no_progress_s: a robot that does not move while it has a target (its body meets

@@ -2,11 +2,6 @@
 // the two-floor `house` scene in lockstep: with config/default.yaml the robot finishes the ground
 // floor, climbs the flight blind onto the landing (plan.climb_blind) and explores the upper floor.
 // The paper-literal pipeline (the session 9-11 switches off) is checked on the ground floor.
-#include <fstream>
-#include <sstream>
-#include <utility>
-#include <vector>
-
 #include <gtest/gtest.h>
 
 #include "tests/integration/expectations.hpp"
@@ -46,29 +41,13 @@ TEST(ExploreHouse, BothFloorsSafelyAndDeterministically) {
   EXPECT_EQ(m.coverage_over_time, n.coverage_over_time);
 }
 
-// config/default.yaml with the given "key: value" texts replaced, written to a temporary file;
-// empty if one is not in the file.
-std::string edited_default_config(const std::vector<std::pair<std::string, std::string>>& edits) {
-  std::ifstream in(std::string(STOREY_SOURCE_DIR) + "/config/default.yaml");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  std::string text = ss.str();
-  for (const auto& [from, to] : edits) {
-    const size_t at = text.find(from);
-    if (at == std::string::npos) return "";
-    text.replace(at, from.size(), to);
-  }
-  const std::string path = testing::TempDir() + "/storey_paper_literal.yaml";
-  std::ofstream(path) << text;
-  return path;
-}
-
 // The paper-literal pipeline (no blind climb, no phantom-frontier fixes, no retries) still
 // explores the ground floor safely and ends complete: the switches are the only difference.
 TEST(ExploreHouse, GroundFloorWithTheSwitchesOff) {
   SimRunOptions o = house_options(300);
   o.config =
-      edited_default_config({{"spill_is_surface: true ", "spill_is_surface: false"},
+      edited_default_config("storey_paper_literal.yaml",
+                            {{"spill_is_surface: true ", "spill_is_surface: false"},
                              {"close_probes_at_holes: true ", "close_probes_at_holes: false"},
                              {"climb_blind: true ", "climb_blind: false"},
                              {"target_momentum: true ", "target_momentum: false"},
