@@ -61,6 +61,13 @@ struct GraphOptions {
   // re-link the parts, but nothing makes it: in the office (seed 2) a part that stayed cut held
   // the floor's last cluster, unreachable, and the run ended "complete" at 58 s with 27 % seen.
   bool keep_reachable_cut = false;
+  // Beyond the paper (graph.surface_seen_from_above; session 18). Eq. 5's I(x, z_i) counts a
+  // support surface only if a ray has crossed the voxel above it, or the one above that: the
+  // underside of the floor above, seen from below, has the same "occupied with nothing occupied
+  // above" shape as a floor within a step of a node on the upper floor. test_ramp seed 2: the
+  // upper floor's two side strips, never seen from above, held no frontier (rho 0.04) and the run
+  // ended "complete" with that floor at 32 %.
+  bool surface_seen_from_above = false;
   // --- incremental update budgets (bounded work per map cycle) ---
   // (~23 us per operation at 0.1 m voxels: these bound a cycle to ~5 ms CPU; PERFORMANCE.md)
   int max_expansions_per_update = 40;     // nodes expanded per update (queue carries over)

@@ -22,7 +22,9 @@ TopologicalFrontiers::TopologicalFrontiers(const GraphOptions& opt) : opt_(opt) 
 
 // Eq. 5. I(x, z_i) = 1 if a support surface lies within a step of z_i under x, or if x is an
 // observed drop (known, so not under-observed). Samples hidden behind an obstacle at body
-// height (walls) are not part of the node's region and are left out of Omega_i.
+// height (walls) are not part of the node's region and are left out of Omega_i. With
+// surface_seen_from_above a surface with no observed air over it (a slab's underside seen from
+// the floor below) is missing, not support.
 float TopologicalFrontiers::missing_surface_ratio(SupportQuery& q, const GraphNode& n,
                                                   int* samples) {
   const float radius = float(opt_.surface_radius_factor * opt_.r_e_m);
@@ -34,7 +36,12 @@ float TopologicalFrontiers::missing_surface_ratio(SupportQuery& q, const GraphNo
     const float x = n.p_m.x() + radius * o.x(), y = n.p_m.y() + radius * o.y();
     if (q.walk(eye, Eigen::Vector3f(x, y, eye.z()), false) == Occupancy::kOccupied) continue;
     ++omega;
-    if (q.surface_near(x, y, n.p_m.z(), q.step())) continue;
+    if (const auto s = q.surface_near(x, y, n.p_m.z(), q.step())) {
+      if (!opt_.surface_seen_from_above) continue;
+      const map::VoxelKey up{s->key.x, s->key.y, s->key.z + 1},
+          up2{s->key.x, s->key.y, s->key.z + 2};
+      if (q.occupancy(up) == Occupancy::kFree || q.occupancy(up2) == Occupancy::kFree) continue;
+    }
     const map::VoxelKey k{int32_t(std::floor(x * inv)), int32_t(std::floor(y * inv)),
                           int32_t(std::floor(n.p_m.z() * inv))};
     const map::VoxelKey below{k.x, k.y, int32_t(std::floor((n.p_m.z() - q.step()) * inv))};

@@ -369,3 +369,42 @@ TEST(TopologicalFrontiers, ProbeThroughAHoleInAWallIsClosed) {
     EXPECT_TRUE(q.probe_open_climbing(foot, Eigen::Vector2f(0, 1), 3.0f, 0.3f, 0.2f, 0.3f));
   }
 }
+
+// GraphOptions::surface_seen_from_above: a 0.2 m slab seen from the floor below, then its top
+// seen from above near one end only. Off, Eq. 5 takes the slab's underside, within a step of the
+// upper floor's nodes, for the floor beyond what was seen: no node there is C_sur (test_ramp
+// seed 2's gallery strips, session 18). On, the nodes at the edge of the seen part are.
+TEST(TopologicalFrontiers, ASlabSeenFromBelowIsNoSurfaceForTheFloorAbove) {
+  World w;
+  w.add({0, -2, -0.3f}, {10, 2, 0.0f});  // ground floor
+  w.add({0, -2, 2.8f}, {10, 2, 3.0f});   // the upper floor's slab
+  w.add({-0.2f, -2.2f, -0.3f}, {10.2f, -2, 6});  // walls around both floors
+  w.add({-0.2f, 2, -0.3f}, {10.2f, 2.2f, 6});
+  w.add({-0.2f, -2, -0.3f}, {0, 2, 6});
+  w.add({10, -2, -0.3f}, {10.2f, 2, 6});
+  for (const bool on : {false, true}) {
+    SCOPED_TRACE(on ? "graph.surface_seen_from_above on" : "off");
+    GraphOptions o;
+    o.surface_seen_from_above = on;
+    o.use_c_exp = false;  // C_sur alone
+    Harness h(o);
+    h.observe(w, Vector3f(5, 0, 0.55f), Vector3f(5, 0, 0), 150000, 1, 12.0f);
+    h.observe(w, Vector3f(1, 0, 3.45f), Vector3f(1, 0, 3.0f), 150000, 2, 2.5f);
+    int upper = 0, c_sur = 0;
+    float rho_max = 0;
+    for (NodeId i = 0; i < h.graph.node_capacity(); ++i) {
+      const GraphNode& n = h.graph.node(i);
+      if (!n.alive || n.p_m.z() < 2.5f) continue;
+      ++upper;
+      c_sur += n.c_sur;
+      rho_max = std::max(rho_max, n.rho);
+    }
+    ASSERT_GT(upper, 3);
+    if (on) {
+      EXPECT_GT(c_sur, 0);
+      EXPECT_GE(rho_max, 0.3f);
+    } else {
+      EXPECT_EQ(c_sur, 0) << "rho max " << rho_max;
+    }
+  }
+}

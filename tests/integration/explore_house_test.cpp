@@ -99,6 +99,23 @@ TEST(ExploreHouse, RefusesBadMethodAndAblation) {
   EXPECT_THROW(run_exploration(o), std::invalid_argument);
 }
 
+// A bad --config names the file, the line and the key before anything runs.
+TEST(ExploreHouse, ABadConfigNamesItsKeyAndLine) {
+  SimRunOptions o = house_options(10);
+  o.config =
+      edited_default_config("storey_bad_key.yaml", {{"climb_blind: true ", "climb_blind: tru  "}});
+  ASSERT_FALSE(o.config.empty()) << "config/default.yaml has no plan.climb_blind: true";
+  try {
+    run_exploration(o);
+    FAIL() << "a config with climb_blind: tru ran";
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("storey_bad_key.yaml:"), std::string::npos) << what;
+    EXPECT_NE(what.find("plan.climb_blind: expected true or false, got 'tru'"), std::string::npos)
+        << what;
+  }
+}
+
 TEST(ExploreHouse, MetricsNameTheMethodAndHowTheRunEnded) {
   RunMetrics m;
   m.method = "tare-like";

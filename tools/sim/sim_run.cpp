@@ -47,9 +47,9 @@ config::Parameters load_parameters(const std::string& path) {
   config::Result r = config::load(file);
   if (!r.ok()) {
     const auto& e = r.errors.front();
-    throw std::invalid_argument("--config " + file + ": " + e.message + " (" +
+    throw std::invalid_argument("--config " + e.to_string() + " (" +
                                 std::to_string(r.errors.size()) +
-                                " error(s); see storey check-config)");
+                                " error(s); see storey check-config " + file + ")");
   }
   return r.params;
 }
