@@ -26,27 +26,27 @@ void expect_both_floors_safely(const SimRunResult& r) {
 TEST(ExploreStair, AClimbStoppedOnTheFlightGoesOnUpAndTheRunEndsComplete) {
   const SimRunResult r = run_exploration(quiet_run("test_stair", 1, 300));
   const RunMetrics& m = r.metrics;
-  // Measured (seed 1, session 12): complete at 85.5 s, floors 0.858 / 0.811. Before: the climb
+  // Measured (seed 1, session 18): complete at 135.0 s, floors 0.884 / 0.847. With flight_foot,
+  // near a climb deferred beside the flight but facing away, it walks to the deferral's pose
+  // again (session 17 dropped it there and ended at 86.5 s with the upper floor at 0.0). Session
+  // 12 (before flight_foot): 85.5 s, 0.858 / 0.811. Before that: the climb
   // ended mid-flight (z ~ 1.5 m), no graph node grew there and the run ended complete at 71.0 s
   // with the upper floor at 0.058; with that fixed but the completion check counting the climbed
   // flight's frontiers, it ran to the 300 s limit.
   expect_both_floors_safely(r);
-  EXPECT_LT(m.exploration_time_s, 200.0);
+  EXPECT_LT(m.exploration_time_s, 260.0);
 }
 
-// With plan.flight_foot (off by default), seed 2 climbs test_stair's flight to its 1.07 m landing
-// (top riser to wall) and must turn there to reach the upper floor. The blind-ring ground entered
-// on the top tread while climbing laid the landing 0.17 m low in the map: every trajectory onto it
-// pitched the body into the railing, each upper-floor cluster was set aside in turn and the run
-// ended "complete" with the upper floor at 18.4 % (session 16). Now that ground is entered only
-// where the robot walks level or a climb has ended on its landing (firmware/blind_support.hpp).
-TEST(ExploreStair, WithFlightFootTheNarrowLandingIsEnteredAtItsOwnHeight) {
-  SimRunOptions o = quiet_run("test_stair", 2, 300);
-  o.config = edited_default_config("storey_flight_foot.yaml",
-                                   {{"flight_foot: false", "flight_foot: true "}});
-  ASSERT_FALSE(o.config.empty()) << "config/default.yaml has no plan.flight_foot: false";
-  // Measured (seed 2, session 17): complete at 148.0 s, floors 0.893 / 0.847.
-  expect_both_floors_safely(run_exploration(o));
+// Seed 2 climbs test_stair's flight to its 1.07 m landing (top riser to wall) and must turn
+// there to reach the upper floor. With plan.flight_foot, the blind-ring ground entered on the top
+// tread while climbing laid the landing 0.17 m low in the map: every trajectory onto it pitched
+// the body into the railing, each upper-floor cluster was set aside in turn and the run ended
+// "complete" with the upper floor at 18.4 % (session 16). Now that ground is entered only where
+// the robot walks level or a climb has ended on its landing (firmware/blind_support.hpp).
+TEST(ExploreStair, TheNarrowLandingIsEnteredAtItsOwnHeight) {
+  // Measured (seed 2, session 18): complete at 142.0 s, floors 0.892 / 0.872 (session 17,
+  // flight_foot alone: 148.0 s, 0.893 / 0.847).
+  expect_both_floors_safely(run_exploration(quiet_run("test_stair", 2, 300)));
 }
 
 }  // namespace
