@@ -10,6 +10,9 @@
 
 namespace storey::core::plan {
 
+// Climbs tried near a deferred climb that found no flight before it is given up (flight_foot).
+constexpr int kMaxDeferredClimbMisses = 4;
+
 const char* to_string(LocalPlanStatus s) {
   switch (s) {
     case LocalPlanStatus::kNewTrajectory:
@@ -1058,7 +1061,12 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
       }
       // With flight_foot, near it but facing elsewhere, no flight ahead: to its pose, as from
       // afar (test_stair seed 1, session 17: 0.4 m from it facing away, the climb found no
-      // flight, the deferral was dropped and the upper floor never explored).
+      // flight, the deferral was dropped and the upper floor never explored). Bounded: a pose
+      // from which no climb is ever found would be walked to forever.
+      if (++deferred_climb_->misses >= kMaxDeferredClimbMisses) {
+        deferred_climb_.reset();
+        return false;
+      }
     }
     SetAsideReason why = SetAsideReason::kAstarFailed;
     const bool ok =

@@ -311,6 +311,7 @@ class LocalPlanner {
     double yaw_rad;
     std::optional<FlightFoot> flight;  // found by to_flight_foot: climbed from its foot
     int failures = 0;                  // cycles in which no way back to it was found
+    int misses = 0;                    // climbs tried near it that found no flight (flight_foot)
   };
   std::optional<DeferredClimb> deferred_climb_;
   int climb_deferrals_ = 0;  // climbs deferred since the last climb
