@@ -176,6 +176,7 @@ void read_plan(SectionReader&& r, core::plan::PlanOptions& o) {
   r.get("flight_foot", o.flight_foot);
   r.get("brake_start", o.brake_start);
   r.get("no_progress_s", o.no_progress_s, Range{0.0, 600.0});
+  r.get("stale_floor_s", o.stale_floor_s, Range{0.0, 3600.0});
   r.get("incremental_maintenance", o.incremental_maintenance);
 }
 

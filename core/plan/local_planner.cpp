@@ -431,6 +431,16 @@ bool LocalPlanner::no_progress(const LocalPlanInput& in) {
   return true;
 }
 
+bool LocalPlanner::floor_stale(const LocalPlanInput& in) {
+  const size_t nodes = in.graph->node_count();
+  if (nodes >= growth_mark_nodes_ + size_t(std::max(opt_.stale_floor_nodes, 0)) ||
+      in.t_s < growth_mark_t_s_) {
+    growth_mark_nodes_ = std::max(nodes, growth_mark_nodes_);
+    growth_mark_t_s_ = in.t_s;
+  }
+  return plan_opt_.stale_floor_s > 0 && in.t_s - growth_mark_t_s_ >= plan_opt_.stale_floor_s;
+}
+
 Eigen::Vector3f LocalPlanner::blocking_point(const LocalPlanInput& in) const {
   const map::MapView& view = *in.view;
   const double vs = view.voxel_size_m();
@@ -885,6 +895,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     return true;
   };
   out.set_aside_expired = expire_set_aside(in);
+  const bool stale = floor_stale(in);
 
   // No progress: the robot stood still with a target for no_progress_s. The target's cluster is
   // set aside and the robot steps away from what its body meets (an escape; else plans anew).
@@ -1096,6 +1107,10 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
 
   // ---- Stage 1: TSP over the cluster representatives (graph path costs).
   probe_mark(probe_, PlanStage::kLocalStage1);
+  // Frontiers remain but the graph has stopped growing: they cannot be resolved from this floor
+  // (PlanOptions::stale_floor_s); the climb left for last is taken.
+  if (stale && deferred_climb_ && climb_last())
+    return to_climb("climb on: the floor's graph stopped growing, up the flight left for last");
   if (in.clusters->empty()) {
     if (try_climb(true)) return commit_climb("climb on: no frontier, standing on a flight");
     if (climb_last()) return to_climb("climb on: no frontier, up the flight left for last");

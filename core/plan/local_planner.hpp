@@ -139,6 +139,9 @@ struct LocalPlannerOptions {
   // clusters, set aside at their viewpoints, came back whenever the map near them changed (the
   // office, seed 2: deferred at least 4 times in 600 s, the upper floor never reached).
   int max_climb_deferrals = 2;
+  // PlanOptions::stale_floor_s: the graph grew by fewer nodes than this past its largest size
+  // (sensor noise and pruning add and remove a few; a walk into unseen rooms adds hundreds).
+  int stale_floor_nodes = 30;
   // With PlanOptions::flight_foot a deferral counts only with at most this many other clusters.
   int climb_deferral_max_others = 2;
   // With PlanOptions::flight_foot: cycles without a way back to a climb left for last before it
@@ -228,6 +231,8 @@ class LocalPlanner {
   // PlanOptions::no_progress_s: true once the robot stood that long with a target (then the
   // clock starts again).
   bool no_progress(const LocalPlanInput& in);
+  // PlanOptions::stale_floor_s: true once the graph has not grown for that long.
+  bool floor_stale(const LocalPlanInput& in);
   void brake_start(const LocalPlanInput& in);  // PlanOptions::brake_start: moves start_foot_m_
   // The nearest occupied voxel in the body's height band within 0.6 m of the robot, else the
   // point 0.45 m ahead of it: what a body that does not move meets.
@@ -326,6 +331,9 @@ class LocalPlanner {
   Eigen::Vector3d progress_foot_m_ = Eigen::Vector3d::Constant(NAN);
   double progress_yaw_ = 0, progress_t_s_ = 0;
   uint64_t no_progress_events_ = 0;
+  // PlanOptions::stale_floor_s: the graph's largest size and when it last grew past it.
+  size_t growth_mark_nodes_ = 0;
+  double growth_mark_t_s_ = 0;
   // Flights climbed blind: the climb's foot points and its landing height. Their frontiers stay
   // (the treads are edge-on from on the flight) and nothing resolves them from below; once the
   // landing's graph links to the flight's they would send the robot back down.

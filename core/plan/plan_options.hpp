@@ -70,6 +70,13 @@ struct PlanOptions {
   // a table leg). The target's cluster is set aside and the robot steps away from the nearest
   // obstacle. 0: off.
   double no_progress_s = 0.0;
+  // Beyond the paper, with climb_blind (session 19): a climb left for last is taken once the
+  // reachable graph has not grown (LocalPlannerOptions::stale_floor_nodes past its largest size)
+  // for this long, though frontiers remain: they are ones the robot cannot resolve from this
+  // floor. In the teaching building's stair hub ten such clusters came back whenever the map
+  // near them changed, the climb deferred at 1020 s was never retaken, and the upper floor stayed
+  // at 0 % at 1800 s. 0: off (a deferred climb waits until no target is left).
+  double stale_floor_s = 0.0;
   // Beyond the paper (session 14, with climb_blind): a frontier cluster about to be set aside (its
   // viewpoint reached and still a frontier, or Stage 3 failing) with a flight's first riser within
   // 1.5 m is first approached at the flight's foot (flight_foot: on its axis, facing up, 0.45 m

@@ -452,7 +452,7 @@ TEST(ConfigSchema, CoreOptionStructsAreFullyMapped) {
   EXPECT_EQ(sizeof(core::map::MapOptions), 152u) << "MapOptions changed: update the config schema";
   EXPECT_EQ(sizeof(core::graph::GraphOptions), 216u)
       << "GraphOptions changed: update the config schema";
-  EXPECT_EQ(sizeof(core::plan::PlanOptions), 256u)
+  EXPECT_EQ(sizeof(core::plan::PlanOptions), 264u)
       << "PlanOptions changed: update the config schema";
 }
 
