@@ -71,6 +71,9 @@ struct TrajectoryOptions {
   bool shortcut = true;
   bool reachable_only = true;  // shortcut support must be in C_reach (else S_trav suffices)
   int max_repairs = 8;         // pinned vertices before falling back to the whole polyline
+  // The spacing is halved into every sharp corner (up to three times), so one corner does not
+  // slow the whole curve (one knot interval) below what its straight parts allow.
+  bool grade_corners = false;
 };
 
 enum class TrajectoryStatus : uint8_t {

@@ -220,6 +220,28 @@ bool LocalPlanner::retry_from_elsewhere(const LocalPlanInput& in, LocalPlanResul
 
 void LocalPlanner::adopt_target(const LocalPlanInput& in, const graph::FrontierCluster& c,
                                 LocalPlanResult& out) {
+  // PlanOptions::replan_only_if_faster: a periodic replan to the same cluster whose trajectory
+  // (from rest where the robot would stop, after braking there) arrives no earlier than the one
+  // followed keeps the one followed. Each new trajectory starts at rest: one every replan_period_s
+  // held the walk far below the speed limit (office seed 1: 0.56 m/s while walking, session 20).
+  const bool periodic = periodic_;
+  periodic_ = false;
+  if (periodic && c.id == target_cluster_ && !current_.empty() && !out.trajectory.empty()) {
+    const double brake_s = in.robot_velocity_mps.norm() / std::max(robot_.max_accel_mps2, 1e-3);
+    const double left_s = current_.t_end() - in.t_s;
+    if (left_s <= brake_s + out.trajectory.duration() + kFasterMarginS) {
+      has_target_ = true;
+      remember_target(in, c);
+      planned_at_s_ = in.t_s;
+      out = LocalPlanResult{};
+      out.status = LocalPlanStatus::kKeep;
+      out.target_cluster = target_cluster_;
+      out.target_m = target_m_;
+      out.real_until_s = current_.t_end();
+      out.replan_reason = "periodic replan: the trajectory followed arrives as early";
+      return;
+    }
+  }
   start_escapes_ = climbs_ = descents_ = 0;
   committed_ = false;
   has_target_ = true;
@@ -855,6 +877,7 @@ bool LocalPlanner::try_target(const LocalPlanInput& in, const Viewpoint& vp, Loc
 
 LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   LocalPlanResult out;
+  periodic_ = false;
   if (!in.view || !in.graph || !in.clusters || !in.viewpoints || !in.robot_foot_m.allFinite()) {
     out.status = LocalPlanStatus::kBadInput;
     return out;
@@ -1002,6 +1025,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
         reason = "periodic replan";
         has_target_ = false;
         kept_cluster = tc ? tc->id : -1;
+        periodic_ = plan_opt_.replan_only_if_faster && tc;
       } else {
         out.status = LocalPlanStatus::kKeep;
         flight_target_ = flight_target;

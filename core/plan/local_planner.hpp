@@ -286,6 +286,8 @@ class LocalPlanner {
   std::vector<Eigen::Vector3d> start_nodes_m_;  // nearest confirmed nodes (blind-ring starts)
   // Current target.
   bool has_target_ = false;
+  bool periodic_ = false;  // this plan() is a periodic replan (PlanOptions::replan_only_if_faster)
+  static constexpr double kFasterMarginS = 1.0;  // a new trajectory must arrive this much earlier
   int32_t target_cluster_ = -1;
   std::vector<Eigen::Vector3f> target_nodes_m_;  // the target cluster's frontier nodes
   Eigen::Vector3d target_m_ = Eigen::Vector3d::Zero();

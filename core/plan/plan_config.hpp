@@ -38,6 +38,7 @@ inline TrajectoryOptions trajectory_options(const PlanOptions& o) {
   TrajectoryOptions t;
   t.control_spacing_m = o.traj_control_spacing_m;
   t.max_repairs = o.traj_max_repairs;
+  t.grade_corners = o.traj_grade_corners;
   t.reachable_only = o.astar_reachable_only;
   return t;
 }

@@ -27,6 +27,7 @@ struct PlanOptions {
   // Stage 3: B-spline (bspline_trajectory.hpp).
   double traj_control_spacing_m = 0.5;  // control point spacing along the pruned path
   int traj_max_repairs = 8;             // pinned vertices before the polyline fallback
+  bool traj_grade_corners = false;      // spacing halved into sharp corners (one dt per curve)
   // FCL look-ahead of the control task (collision_checker.hpp).
   double lookahead_s = 1.0;  // T: check the next T seconds of the trajectory
   // Macro layer (Sec. IV-A..C; exploration_planner.hpp).
@@ -77,6 +78,10 @@ struct PlanOptions {
   // near them changed, the climb deferred at 1020 s was never retaken, and the upper floor stayed
   // at 0 % at 1800 s. 0: off (a deferred climb waits until no target is left).
   double stale_floor_s = 0.0;
+  // Session 20: a periodic replan to the same cluster publishes its trajectory only if it arrives
+  // at least LocalPlanner::kFasterMarginS earlier than the one followed (every new trajectory
+  // starts at rest: the robot slowed down at every replan).
+  bool replan_only_if_faster = false;
   // Beyond the paper (session 14, with climb_blind): a frontier cluster about to be set aside (its
   // viewpoint reached and still a frontier, or Stage 3 failing) with a flight's first riser within
   // 1.5 m is first approached at the flight's foot (flight_foot: on its axis, facing up, 0.45 m

@@ -128,6 +128,42 @@ TEST(BsplineTrajectory, StraightWalksAndTurnsInPlaceUseTheLimits) {
   EXPECT_GT(peak(back.trajectory).first, 0.95 * robot.max_speed_mps);
 }
 
+// TrajectoryOptions::grade_corners: one right-angle corner held the whole L-shaped walk (one knot
+// interval) to 0.84 v_max; with the spacing halved into the corner the straight parts reach v_max
+// and the curve slows for the corner only, within every limit.
+TEST(BsplineTrajectory, GradedCornersLetTheStraightsReachTheSpeedLimit) {
+  map::TraversabilityMap empty;
+  RobotModel robot;
+  CollisionChecker cc(robot, 0.1);
+  const std::vector<Eigen::Vector3d> ell{{0, 0, 0}, {4, 0, 0}, {4, 4, 0}};
+  auto peak_speed = [](const BsplineTrajectory& t) {
+    double v = 0;
+    for (double s = t.t_start(); s <= t.t_end(); s += 0.005)
+      v = std::max(v, t.sample(s).v_mps.head<2>().norm());
+    return v;
+  };
+  const TrajectoryResult plain =
+      TrajectoryBuilder(robot).build(empty.view(), cc, ell, 0.0, std::nullopt, 0.0);
+  const TrajectoryResult graded = TrajectoryBuilder(robot, TrajectoryOptions{.grade_corners = true})
+                                      .build(empty.view(), cc, ell, 0.0, std::nullopt, 0.0);
+  ASSERT_EQ(plain.status, TrajectoryStatus::kOk);
+  ASSERT_EQ(graded.status, TrajectoryStatus::kOk);
+  EXPECT_LT(peak_speed(plain.trajectory), 0.9 * robot.max_speed_mps);  // 0.84
+  EXPECT_GT(peak_speed(graded.trajectory), 0.95 * robot.max_speed_mps);
+  EXPECT_LT(graded.trajectory.duration(), 0.95 * plain.trajectory.duration());  // 12.0 s, 13.1 s
+  expect_limits(graded.trajectory, robot);
+  const BsplineTrajectory& t = graded.trajectory;
+  EXPECT_NEAR((t.sample(t.t_end()).p_m - ell.back()).norm(), 0, 1e-9);
+  // It hugs the corner at least as close as the plain curve.
+  auto corner_gap = [&](const BsplineTrajectory& u) {
+    double d = 1e9;
+    for (double s = u.t_start(); s <= u.t_end(); s += 0.005)
+      d = std::min(d, (u.sample(s).p_m - ell[1]).head<2>().norm());
+    return d;
+  };
+  EXPECT_LE(corner_gap(t), corner_gap(plain.trajectory));
+}
+
 // Turning in place: the control points differ by a millimetre in x and a centimetre of surface
 // noise in z. The body's pitch stays level (it was atan(10 / 1) = 84 deg, which put the box into
 // the next stair riser in the look-ahead).

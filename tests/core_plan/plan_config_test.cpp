@@ -15,6 +15,7 @@ TEST(PlanConfig, OptionsFlowIntoComponents) {
   o.astar_max_expansions = 1234;
   o.astar_reachable_only = false;
   o.traj_control_spacing_m = 0.4;
+  o.traj_grade_corners = true;
   EXPECT_EQ(tsp_options(o).exact_max_n, 9);
   const ViewpointDpOptions d = dp_options(o);
   EXPECT_EQ(d.window_w, 3);
@@ -25,6 +26,7 @@ TEST(PlanConfig, OptionsFlowIntoComponents) {
   EXPECT_FALSE(astar_options(o).reachable_only);
   EXPECT_DOUBLE_EQ(trajectory_options(o).control_spacing_m, 0.4);
   EXPECT_FALSE(trajectory_options(o).reachable_only);
+  EXPECT_TRUE(trajectory_options(o).grade_corners);
   o.astar_max_expansions = -5;  // nonsense from a config: still a bounded, non-zero search
   EXPECT_EQ(astar_options(o).max_expansions, 1u);
 }
