@@ -117,6 +117,8 @@ void read_graph(SectionReader&& r, core::graph::GraphOptions& o) {
   r.get("boundary_frontiers", o.boundary_frontiers);
   r.get("close_probes_at_holes", o.close_probes_at_holes);
   r.get("keep_reachable_cut", o.keep_reachable_cut);
+  r.get("relink_cuts", o.relink_cuts);
+  r.get("relink_tries", o.relink_tries, Range{1, 1000});
   r.get("surface_seen_from_above", o.surface_seen_from_above);
   r.get("neighbour_radius_factor", o.neighbour_radius_factor, Range{1.0, 5.0});
   r.get_deg("max_edge_slope_deg", o.max_edge_slope_rad, Range{0.0, 75.0});

@@ -61,6 +61,15 @@ struct GraphOptions {
   // re-link the parts, but nothing makes it: in the office (seed 2) a part that stayed cut held
   // the floor's last cluster, unreachable, and the run ended "complete" at 58 s with 27 % seen.
   bool keep_reachable_cut = false;
+  // Beyond the paper, off (graph.relink_cuts; session 20): what keep_reachable_cut keeps, nothing
+  // re-links. Office seed 3 (with plan.replan_only_if_faster): the robot walked through a door,
+  // the one edge through it was pruned (the frame seen at close range inside its clearance), the
+  // room and the rest stayed two components and the run ended "complete" at 85.5 s with 48.6 %
+  // seen. Each second, while real nodes lie outside the robot's component, the closest pairs
+  // across the cut (within neighbour_radius_factor * r_e) are tried as edges, the alpha_min
+  // spacing rule waived (a bridge is worth a crowded fan), at most relink_tries per second.
+  bool relink_cuts = false;
+  int relink_tries = 16;
   // Beyond the paper (graph.surface_seen_from_above; session 18). Eq. 5's I(x, z_i) counts a
   // support surface only if a ray has crossed the voxel above it, or the one above that: the
   // underside of the floor above, seen from below, has the same "occupied with nothing occupied

@@ -443,6 +443,87 @@ void ReachableGraph::prune_disconnected(GraphUpdateStats& st) {
     }
 }
 
+// GraphOptions::relink_cuts: the closest node pairs across a cut of G_real, tried as an edge, and
+// (the four closest) through a new node between them, shifted across the pair's line: a 0.9 m
+// door leaves the body's 0.3 m half width a few centimetres either side of its middle, which a
+// straight edge between two nodes placed by Eq. 4's random expansion rarely passes.
+void ReachableGraph::relink_cut(SupportQuery& q, GraphUpdateStats& st) {
+  mark_.resize(nodes_.size(), 0);
+  if (++mark_epoch_ == 0) {
+    std::fill(mark_.begin(), mark_.end(), 0);
+    mark_epoch_ = 1;
+  }
+  bfs_.clear();
+  bfs_.push_back(root_);
+  mark_[root_] = mark_epoch_;
+  for (size_t h = 0; h < bfs_.size(); ++h) {
+    const GraphNode& n = nodes_[bfs_[h]];
+    for (int k = 0; k < n.degree; ++k) {
+      const NodeId o = edges_[n.edges[k]].other(bfs_[h]);
+      if (mark_[o] != mark_epoch_) {
+        mark_[o] = mark_epoch_;
+        bfs_.push_back(o);
+      }
+    }
+  }
+  if (bfs_.size() >= node_count_) return;  // one component
+  const float r = float(opt_.neighbour_radius_factor * opt_.r_e_m);
+  const float window = float(opt_.r_e_m * std::tan(opt_.max_edge_slope_rad)) + q.step();
+  bridges_.clear();
+  for (NodeId i : bfs_) {
+    if (nodes_[i].degree >= opt_.k_max) continue;
+    scratch_.clear();
+    nodes_within(nodes_[i].p_m, r, window, scratch_);
+    for (NodeId j : scratch_)
+      if (nodes_[j].alive && mark_[j] != mark_epoch_ && nodes_[j].degree < opt_.k_max)
+        bridges_.push_back({(nodes_[i].p_m - nodes_[j].p_m).squaredNorm(), {i, j}});
+  }
+  std::sort(bridges_.begin(), bridges_.end());
+  auto valid = [&](NodeId a, NodeId b, EdgeCheck& ec) {
+    ec = q.check_edge(nodes_[a].p_m, nodes_[b].p_m);
+    return ec.valid() && (opt_.use_tentative || edge_state(a, b, ec) == ElementState::kConfirmed);
+  };
+  int tries = 0;
+  for (const auto& [d2, ij] : bridges_) {
+    if (tries++ >= opt_.relink_tries) break;
+    const auto [i, j] = ij;
+    if (nodes_[i].degree >= opt_.k_max || nodes_[j].degree >= opt_.k_max) continue;
+    EdgeCheck ec;
+    if (valid(i, j, ec)) {
+      add_edge(i, j, ec);
+      ++st.edges_added;
+      ++st.relinked;
+      return;  // the parts are one; any other cut waits for the next second
+    }
+    if (tries > 4) continue;
+    const Eigen::Vector3f a = nodes_[i].p_m, b = nodes_[j].p_m;
+    const Eigen::Vector2f d = (b - a).head<2>();
+    if (d.norm() < 1e-3f) continue;
+    const Eigen::Vector2f lat = Eigen::Vector2f(-d.y(), d.x()).normalized();
+    for (int k = 0; k <= 16; ++k) {
+      const float off = 0.05f * float((k + 1) / 2) * (k % 2 ? 1.0f : -1.0f);  // 0, +-0.05, ...
+      const Eigen::Vector3f m = 0.5f * (a + b) + off * Eigen::Vector3f(lat.x(), lat.y(), 0.0f);
+      const std::optional<Support> s = q.support_dilated(m.x(), m.y(), m.z(), q.step());
+      bool confirmed = false;
+      if (!s || q.classify_node(*s, &confirmed) != Reject::kNone) continue;
+      EdgeCheck e1 = q.check_edge(a, s->p_m), e2 = q.check_edge(s->p_m, b);
+      if (!e1.valid() || !e2.valid()) continue;
+      const NodeId mid = add_node(*s, confirmed);
+      ++st.nodes_added;
+      if (!valid(i, mid, e1) || !valid(mid, j, e2)) {  // the node's own state decides
+        remove_node(mid);
+        continue;
+      }
+      add_edge(i, mid, e1);
+      add_edge(mid, j, e2);
+      st.edges_added += 2;
+      st.relinked += 2;
+      queue_expand(mid);
+      return;
+    }
+  }
+}
+
 GraphUpdateStats ReachableGraph::update(const map::MapView& view, const Eigen::Vector3f& foot,
                                         std::span<const Aabb> changed, std::mt19937_64& rng) {
   GraphUpdateStats st;
@@ -492,6 +573,9 @@ GraphUpdateStats ReachableGraph::update(const map::MapView& view, const Eigen::V
     nodes_[i].queued &= ~GraphNode::kQueuedExpand;
     if (nodes_[i].alive) expand(q, i, rng, st);
   }
+
+  // 4b. A cut kept (keep_reachable_cut) is re-linked where an edge across it is valid.
+  if (opt_.relink_cuts && root_ != kNoId && cycle_ % 10 == 0) relink_cut(q, st);
 
   // 5. Components cut off from the robot.
   if (connectivity_lost_ || deferred_updates_ > 0) prune_disconnected(st);

@@ -91,6 +91,7 @@ struct GraphUpdateStats {
   uint32_t promoted = 0;        // S_tent -> S_conf (nodes and edges)
   uint32_t demoted = 0;         // S_conf -> S_tent (left C_reach but still valid)
   uint32_t disconnected = 0;    // nodes removed by the BFS from the robot
+  uint32_t relinked = 0;        // edges added across a cut (GraphOptions::relink_cuts)
   bool prune_deferred = false;  // cut off from the robot but the larger part: kept for now
   uint32_t pending_revalidations = 0, pending_expansions = 0;  // carried over
   uint32_t rejects[int(Reject::kCount)] = {};  // candidate nodes / edges rejected, by reason
@@ -153,6 +154,7 @@ class ReachableGraph {
   void expand(SupportQuery& q, NodeId i, std::mt19937_64& rng, GraphUpdateStats& st);
   NodeId attach_root(SupportQuery& q, const Eigen::Vector3f& foot, GraphUpdateStats& st);
   void prune_disconnected(GraphUpdateStats& st);
+  void relink_cut(SupportQuery& q, GraphUpdateStats& st);
   void queue_expand(NodeId i);
   void queue_revalidate(NodeId i);
   void touch(NodeId i);
@@ -179,6 +181,7 @@ class ReachableGraph {
   std::vector<uint32_t> mark_;
   uint32_t mark_epoch_ = 0;
   uint32_t cycle_ = 0;
+  std::vector<std::pair<float, std::pair<NodeId, NodeId>>> bridges_;  // relink_cut's candidates
 };
 
 }  // namespace storey::core::graph

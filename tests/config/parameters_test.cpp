@@ -450,7 +450,7 @@ TEST(ConfigSchema, CoreOptionStructsAreFullyMapped) {
   // MapOptions::pool_short_risers and GraphOptions::climb_frontiers / root_off_graph are set by
   // plan.climb_blind.
   EXPECT_EQ(sizeof(core::map::MapOptions), 152u) << "MapOptions changed: update the config schema";
-  EXPECT_EQ(sizeof(core::graph::GraphOptions), 216u)
+  EXPECT_EQ(sizeof(core::graph::GraphOptions), 224u)
       << "GraphOptions changed: update the config schema";
   EXPECT_EQ(sizeof(core::plan::PlanOptions), 264u)
       << "PlanOptions changed: update the config schema";
