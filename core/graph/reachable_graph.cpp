@@ -395,12 +395,9 @@ NodeId ReachableGraph::attach_root(SupportQuery& q, const Eigen::Vector3f& foot,
 // After removals: BFS from the robot's node; whatever it does not reach is no longer part of
 // the reachable support structure (Sec. III-B). A cut that leaves the robot in the smaller part
 // waits GraphOptions::prune_persistence_updates for the link to come back before pruning.
-void ReachableGraph::prune_disconnected(GraphUpdateStats& st) {
-  if (root_ == kNoId) return;
-  if (nodes_[root_].degree == 0 && node_count_ > 1) {
-    st.root_isolated = true;
-    return;
-  }
+// BFS from the robot's node over G_real: bfs_ holds its component, mark_[i] == mark_epoch_ marks
+// it.
+void ReachableGraph::mark_root_component() {
   mark_.resize(nodes_.size(), 0);
   if (++mark_epoch_ == 0) {
     std::fill(mark_.begin(), mark_.end(), 0);
@@ -419,6 +416,15 @@ void ReachableGraph::prune_disconnected(GraphUpdateStats& st) {
       }
     }
   }
+}
+
+void ReachableGraph::prune_disconnected(GraphUpdateStats& st) {
+  if (root_ == kNoId) return;
+  if (nodes_[root_].degree == 0 && node_count_ > 1) {
+    st.root_isolated = true;
+    return;
+  }
+  mark_root_component();
   // Cut off, but still in C_reach (GraphOptions::keep_reachable_cut): kept.
   auto cut = [&](NodeId i) {
     return nodes_[i].alive && mark_[i] != mark_epoch_ &&
@@ -448,24 +454,7 @@ void ReachableGraph::prune_disconnected(GraphUpdateStats& st) {
 // door leaves the body's 0.3 m half width a few centimetres either side of its middle, which a
 // straight edge between two nodes placed by Eq. 4's random expansion rarely passes.
 void ReachableGraph::relink_cut(SupportQuery& q, GraphUpdateStats& st) {
-  mark_.resize(nodes_.size(), 0);
-  if (++mark_epoch_ == 0) {
-    std::fill(mark_.begin(), mark_.end(), 0);
-    mark_epoch_ = 1;
-  }
-  bfs_.clear();
-  bfs_.push_back(root_);
-  mark_[root_] = mark_epoch_;
-  for (size_t h = 0; h < bfs_.size(); ++h) {
-    const GraphNode& n = nodes_[bfs_[h]];
-    for (int k = 0; k < n.degree; ++k) {
-      const NodeId o = edges_[n.edges[k]].other(bfs_[h]);
-      if (mark_[o] != mark_epoch_) {
-        mark_[o] = mark_epoch_;
-        bfs_.push_back(o);
-      }
-    }
-  }
+  mark_root_component();
   if (bfs_.size() >= node_count_) return;  // one component
   const float r = float(opt_.neighbour_radius_factor * opt_.r_e_m);
   const float window = float(opt_.r_e_m * std::tan(opt_.max_edge_slope_rad)) + q.step();

@@ -155,6 +155,7 @@ class ReachableGraph {
   NodeId attach_root(SupportQuery& q, const Eigen::Vector3f& foot, GraphUpdateStats& st);
   void prune_disconnected(GraphUpdateStats& st);
   void relink_cut(SupportQuery& q, GraphUpdateStats& st);
+  void mark_root_component();
   void queue_expand(NodeId i);
   void queue_revalidate(NodeId i);
   void touch(NodeId i);
