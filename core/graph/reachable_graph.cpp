@@ -468,8 +468,7 @@ void ReachableGraph::relink_cut(SupportQuery& q, GraphUpdateStats& st) {
         bridges_.push_back({(nodes_[i].p_m - nodes_[j].p_m).squaredNorm(), {i, j}});
   }
   std::sort(bridges_.begin(), bridges_.end());
-  auto valid = [&](NodeId a, NodeId b, EdgeCheck& ec) {
-    ec = q.check_edge(nodes_[a].p_m, nodes_[b].p_m);
+  auto accept = [&](NodeId a, NodeId b, const EdgeCheck& ec) {
     return ec.valid() && (opt_.use_tentative || edge_state(a, b, ec) == ElementState::kConfirmed);
   };
   int tries = 0;
@@ -477,8 +476,8 @@ void ReachableGraph::relink_cut(SupportQuery& q, GraphUpdateStats& st) {
     if (tries++ >= opt_.relink_tries) break;
     const auto [i, j] = ij;
     if (nodes_[i].degree >= opt_.k_max || nodes_[j].degree >= opt_.k_max) continue;
-    EdgeCheck ec;
-    if (valid(i, j, ec)) {
+    const EdgeCheck ec = q.check_edge(nodes_[i].p_m, nodes_[j].p_m);
+    if (accept(i, j, ec)) {
       add_edge(i, j, ec);
       ++st.edges_added;
       ++st.relinked;
@@ -495,11 +494,11 @@ void ReachableGraph::relink_cut(SupportQuery& q, GraphUpdateStats& st) {
       const std::optional<Support> s = q.support_dilated(m.x(), m.y(), m.z(), q.step());
       bool confirmed = false;
       if (!s || q.classify_node(*s, &confirmed) != Reject::kNone) continue;
-      EdgeCheck e1 = q.check_edge(a, s->p_m), e2 = q.check_edge(s->p_m, b);
+      const EdgeCheck e1 = q.check_edge(a, s->p_m), e2 = q.check_edge(s->p_m, b);
       if (!e1.valid() || !e2.valid()) continue;
       const NodeId mid = add_node(*s, confirmed);
       ++st.nodes_added;
-      if (!valid(i, mid, e1) || !valid(mid, j, e2)) {  // the node's own state decides
+      if (!accept(i, mid, e1) || !accept(mid, j, e2)) {  // the node's own state decides
         remove_node(mid);
         continue;
       }
@@ -563,7 +562,8 @@ GraphUpdateStats ReachableGraph::update(const map::MapView& view, const Eigen::V
     if (nodes_[i].alive) expand(q, i, rng, st);
   }
 
-  // 4b. A cut kept (keep_reachable_cut) is re-linked where an edge across it is valid.
+  // 4b. A cut kept (keep_reachable_cut) is re-linked where an edge across it is valid (every
+  //     10th update: once a second at the map task's 10 Hz).
   if (opt_.relink_cuts && root_ != kNoId && cycle_ % 10 == 0) relink_cut(q, st);
 
   // 5. Components cut off from the robot.

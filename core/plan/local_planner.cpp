@@ -224,9 +224,7 @@ void LocalPlanner::adopt_target(const LocalPlanInput& in, const graph::FrontierC
   // (from rest where the robot would stop, after braking there) arrives no earlier than the one
   // followed keeps the one followed. Each new trajectory starts at rest: one every replan_period_s
   // held the walk far below the speed limit (office seed 1: 0.56 m/s while walking, session 20).
-  const bool periodic = periodic_;
-  periodic_ = false;
-  if (periodic && c.id == target_cluster_ && !current_.empty() && !out.trajectory.empty()) {
+  if (periodic_ && c.id == target_cluster_ && !current_.empty() && !out.trajectory.empty()) {
     const double brake_s = in.robot_velocity_mps.norm() / std::max(robot_.max_accel_mps2, 1e-3);
     const double left_s = current_.t_end() - in.t_s;
     if (left_s <= brake_s + out.trajectory.duration() + kFasterMarginS) {
