@@ -159,6 +159,7 @@ void read_plan(SectionReader&& r, core::plan::PlanOptions& o) {
   r.get("traj_control_spacing_m", o.traj_control_spacing_m, Range{0.05, 5.0});
   r.get("traj_max_repairs", o.traj_max_repairs, Range{0, 1000});
   r.get("traj_grade_corners", o.traj_grade_corners);
+  r.get("traj_retime", o.traj_retime);
   r.get("lookahead_s", o.lookahead_s, Range{0.1, 10.0});
   r.get("floor_stable_s", o.floor_stable_s, Range{0.0, 60.0});
   r.get("floor_stable_band_m", o.floor_stable_band_m, Range{0.01, 1.0});
@@ -178,6 +179,7 @@ void read_plan(SectionReader&& r, core::plan::PlanOptions& o) {
   r.get("climb_axis_ahead_m", o.climb_axis_ahead_m, Range{0.0, 1.5});
   r.get("flight_foot", o.flight_foot);
   r.get("brake_start", o.brake_start);
+  r.get("reference_clock", o.reference_clock);
   r.get("no_progress_s", o.no_progress_s, Range{0.0, 600.0});
   r.get("stale_floor_s", o.stale_floor_s, Range{0.0, 3600.0});
   r.get("replan_only_if_faster", o.replan_only_if_faster);

@@ -276,6 +276,10 @@ void Autonomy::plan_step() {
   in.robot_yaw_rad = pose.yaw_rad;
   in.robot_velocity_mps = pose.velocity_world();
   in.t_s = now;
+  // The lag of the trajectory followed, if it is the one last published.
+  if (TrajectoryProgress pr;
+      opt_.params.plan.reference_clock && progress_mb_.read(pr) != 0 && pr.id == traj_id_)
+    in.trajectory_lag_s = pr.lag_s;
   in.changed_regions = &plan_changes_;
   core::plan::ExplorationResult r = policy_->plan(in);
   if (const core::plan::LocalPlanner* l = policy_->local_layer();
@@ -453,6 +457,7 @@ void Autonomy::control_step() {
     if (ctl_traj_ && !ctl_traj_->trajectory.empty())
       tau_ = ControlLaw::entry_time(ctl_traj_->trajectory,
                                     Eigen::Vector2d(last_pose_.x_m, last_pose_.y_m));
+    lag_s_ = std::max(0.0, now - tau_);  // entered late (braking first, the plan's latency)
   };
   const auto tv = traj_.read();
   if (tv.version != ctl_traj_version_) {
@@ -559,8 +564,12 @@ void Autonomy::control_step() {
     const double yaw_err = std::abs(wrap_angle(ref.yaw_rad - last_pose_.yaw_rad));
     const double rate =
         std::clamp((0.6 - err) / 0.3, 0.0, 1.0) * std::clamp((1.2 - yaw_err) / 0.6, 0.0, 1.0);
+    if (tau_ < tau_end) lag_s_ += dt * (1.0 - rate * brake_k_);
     tau_ = std::min(tau_ + dt * rate * brake_k_, tau_end);
+  } else if (has_traj && tau_ < tau_end) {
+    lag_s_ += dt;  // stopped: the reference waits
   }
+  progress_mb_.write(TrajectoryProgress{has_traj ? ctl_traj_->id : 0, lag_s_});
   // else: zero command (a stop is commanded in this very period; the robot's own deceleration
   // limits bring it to rest).
   cmd.stamp_s = now;

@@ -10,6 +10,7 @@
 //   control -> map/plan pose: Mailbox<PoseSample>
 //   map     -> plan     world model (map snapshot, graph copy, clusters, viewpoints): Snapshot
 //   plan    -> control  trajectory: Snapshot; planner heartbeat: Mailbox<double>
+//   control -> plan     reference lag of the trajectory followed: Mailbox<TrajectoryProgress>
 //   control -> *        command: Mailbox<VelocityCommand>; stop events: SpscQueue -> telemetry
 //   watchdog-> control  overrun flag: atomic
 //   plan    -> *        exploration status: Mailbox<ExplorationStatus>
@@ -55,6 +56,14 @@ struct PlannedTrajectory {
   int32_t target_cluster = -1;
   Eigen::Vector3d target_m = Eigen::Vector3d::Zero();
   std::vector<Eigen::Vector3d> path_m;
+};
+
+// control -> plan: the reference waits for the robot (a turn onto the trajectory, a safety
+// stop), so the trajectory's own clock trails the planner's; a climb judged "done" at its
+// planned end stopped 0.7 m short of the landing (house seed 1 re-timed, session 21).
+struct TrajectoryProgress {
+  uint64_t id = 0;   // PlannedTrajectory::id followed (0: none)
+  double lag_s = 0;  // how far its reference trails the clock [s]
 };
 
 enum class ExplorationState : uint8_t { kStarting = 0, kExploring, kComplete };
@@ -239,7 +248,9 @@ class Autonomy {
   core::plan::CollisionChecker lookahead_;
   uint64_t ctl_traj_version_ = 0, ctl_checked_traj_ = 0, ctl_checked_map_ = 0;
   std::shared_ptr<const PlannedTrajectory> ctl_traj_;
-  double tau_ = 0;         // progress along the trajectory [s] (advances while tracking well)
+  double tau_ = 0;    // progress along the trajectory [s] (advances while tracking well)
+  double lag_s_ = 0;  // now - tau_ while tau_ runs (TrajectoryProgress)
+  rt::Mailbox<TrajectoryProgress> progress_mb_;
   bool entering_ = false;  // a new trajectory the robot has not yet been on (turn_on_reference)
   // plan.brake_start: a new trajectory waits while the robot brakes on the one it follows; the
   // old one's progress and feedforward scaled by brake_k_, falling 1 -> 0 at a_max from brake_v0_.

@@ -33,35 +33,93 @@ BsplineTrajectory::BsplineTrajectory(std::vector<Eigen::Vector3d> ctrl,
   if (!(dt_ > 0)) dt_ = 1.0;
 }
 
+namespace {
+// Re-timing's path parameter: planar metres, and kYawLength metres per radian of yaw (the
+// ratio of the default speed and yaw-rate limits), so a turn in place has length too.
+constexpr double kYawLength = 1.0;
+}  // namespace
+
+BsplineTrajectory::Geometry BsplineTrajectory::geometry(double u) const {
+  Geometry g{};
+  const int n = int(ctrl_.size());
+  if (!std::isfinite(u)) u = 0;
+  u = std::clamp(u, 0.0, double(n - 3));
+  const int i = std::min(int(u), n - 4);
+  const double v = u - i, v2 = v * v, v3 = v2 * v, w = 1 - v;
+  const double b[4] = {w * w * w / 6, (3 * v3 - 6 * v2 + 4) / 6, (-3 * v3 + 3 * v2 + 3 * v + 1) / 6,
+                       v3 / 6};
+  const double d[4] = {-w * w / 2, (3 * v2 - 4 * v) / 2, (-3 * v2 + 2 * v + 1) / 2, v2 / 2};
+  const double a[4] = {w, 3 * v - 2, -3 * v + 1, v};
+  g.p = g.p_u = g.p_uu = Eigen::Vector3d::Zero();
+  g.yaw = g.yaw_u = g.yaw_uu = 0;
+  for (int k = 0; k < 4; ++k) {
+    g.p += b[k] * ctrl_[i + k];
+    g.p_u += d[k] * ctrl_[i + k];
+    g.p_uu += a[k] * ctrl_[i + k];
+    g.yaw += b[k] * yaw_[i + k];
+    g.yaw_u += d[k] * yaw_[i + k];
+    g.yaw_uu += a[k] * yaw_[i + k];
+  }
+  g.segment = i;
+  return g;
+}
+
+bool BsplineTrajectory::path_derivs(const Geometry& g, PathDerivs& d) const {
+  const double L2 = kYawLength * kYawLength;
+  const double su = std::sqrt(g.p_u.head<2>().squaredNorm() + L2 * g.yaw_u * g.yaw_u);
+  d.sigma_u = su;
+  if (!(su > 1e-9)) {
+    d.p_s = d.p_ss = Eigen::Vector3d::Zero();
+    d.yaw_s = d.yaw_ss = 0;
+    return false;
+  }
+  // f_s = f_u / s_u, f_ss = (f_uu - f_s s_uu) / s_u^2, s_uu = (w_u . w_uu) / s_u.
+  const double suu = (g.p_u.head<2>().dot(g.p_uu.head<2>()) + L2 * g.yaw_u * g.yaw_uu) / su;
+  d.p_s = g.p_u / su;
+  d.yaw_s = g.yaw_u / su;
+  d.p_ss = (g.p_uu - d.p_s * suu) / (su * su);
+  d.yaw_ss = (g.yaw_uu - d.yaw_s * suu) / (su * su);
+  return true;
+}
+
 TrajectorySample BsplineTrajectory::sample(double t) const {
   TrajectorySample s;
   if (empty()) return s;
-  const int n = int(ctrl_.size());
-  double ut = std::clamp((t - t0_) / dt_, 0.0, double(n - 3));
-  if (!std::isfinite(ut)) ut = 0;
-  const int i = std::min(int(ut), n - 4);
-  const double u = ut - i, u2 = u * u, u3 = u2 * u, w = 1 - u;
-  const double b[4] = {w * w * w / 6, (3 * u3 - 6 * u2 + 4) / 6, (-3 * u3 + 3 * u2 + 3 * u + 1) / 6,
-                       u3 / 6};
-  const double d[4] = {-w * w / 2, (3 * u2 - 4 * u) / 2, (-3 * u2 + 2 * u + 1) / 2, u2 / 2};
-  const double a[4] = {w, 3 * u - 2, -3 * u + 1, u};
-  double yaw_rate_u = 0;
-  for (int k = 0; k < 4; ++k) {
-    s.p_m += b[k] * ctrl_[i + k];
-    s.v_mps += d[k] * ctrl_[i + k];
-    s.a_mps2 += a[k] * ctrl_[i + k];
-    s.yaw_rad += b[k] * yaw_[i + k];
-    yaw_rate_u += d[k] * yaw_[i + k];
+  Geometry g;
+  if (!retimed()) {
+    g = geometry((t - t0_) / dt_);
+    s.v_mps = g.p_u / dt_;
+    s.a_mps2 = g.p_uu / (dt_ * dt_);
+    s.yaw_rate_rps = g.yaw_u / dt_;
+  } else {
+    // The sample interval holding t; sigma'' is constant in it (sigma_dot^2 linear in sigma).
+    const double tau = std::clamp(std::isfinite(t) ? t - t0_ : 0.0, 0.0, w_t_.back());
+    size_t k = size_t(std::upper_bound(w_t_.begin(), w_t_.end(), tau) - w_t_.begin());
+    k = std::min(k == 0 ? 0 : k - 1, w_t_.size() - 2);
+    const double ds = w_s_[k + 1] - w_s_[k];
+    const double sdd =
+        ds > 0 ? (w_sd_[k + 1] * w_sd_[k + 1] - w_sd_[k] * w_sd_[k]) / (2 * ds) : 0.0;
+    const double h = std::min(tau - w_t_[k], w_t_[k + 1] - w_t_[k]);
+    const double sd = std::max(0.0, w_sd_[k] + sdd * h);
+    const double sg = std::clamp(w_s_[k] + w_sd_[k] * h + 0.5 * sdd * h * h, w_s_[k], w_s_[k + 1]);
+    const double f = ds > 0 ? (sg - w_s_[k]) / ds : 0.0;
+    g = geometry(w_u_[k] + f * (w_u_[k + 1] - w_u_[k]));
+    PathDerivs d;
+    if (path_derivs(g, d)) {
+      s.v_mps = d.p_s * sd;
+      s.a_mps2 = d.p_ss * sd * sd + d.p_s * sdd;
+      s.yaw_rate_rps = d.yaw_s * sd;
+    }
   }
-  s.v_mps /= dt_;
-  s.a_mps2 /= dt_ * dt_;
-  s.yaw_rate_rps = yaw_rate_u / dt_;
+  s.p_m = g.p;
+  s.yaw_rad = g.yaw;
   // Pitch of the terrain along the heading: from the velocity, or the local chord when slow.
   // Slow (turning in place, starting) the ratio of two small numbers is noise: a centimetre of
   // surface noise over a millimetre of travel tilts the box by tens of degrees into the next
   // step. Below half a voxel of chord, level (CollisionChecker::terrain_pitch reads the map).
   // (The same 0.05 bound serves both: m/s of velocity, m of chord.)
   constexpr double kMin = 0.05;
+  const int i = g.segment;
   Eigen::Vector3d dir = s.v_mps;
   if (dir.head<2>().norm() < kMin) dir = ctrl_[i + 3] - ctrl_[i];
   const double len = dir.head<2>().norm();
@@ -79,6 +137,12 @@ BodyPose BsplineTrajectory::pose(double t) const {
 
 double BsplineTrajectory::speed_bound_mps() const {
   double m = 0;
+  if (retimed()) {
+    PathDerivs d;
+    for (size_t k = 0; k < w_u_.size(); ++k)
+      if (path_derivs(geometry(w_u_[k]), d)) m = std::max(m, d.p_s.head<2>().norm() * w_sd_[k]);
+    return m;
+  }
   for (size_t i = 0; i + 1 < ctrl_.size(); ++i)
     m = std::max(m, (ctrl_[i + 1] - ctrl_[i]).head<2>().norm() / dt_);
   return m;
@@ -86,9 +150,147 @@ double BsplineTrajectory::speed_bound_mps() const {
 
 double BsplineTrajectory::accel_bound_mps2() const {
   double m = 0;
+  if (retimed()) {
+    for (double t = t_start(); t <= t_end(); t += 0.01)
+      m = std::max(m, sample(t).a_mps2.head<2>().norm());
+    return m;
+  }
   for (size_t i = 0; i + 2 < ctrl_.size(); ++i)
     m = std::max(m, (ctrl_[i + 2] - 2 * ctrl_[i + 1] + ctrl_[i]).head<2>().norm() / (dt_ * dt_));
   return m;
+}
+
+// Time-optimal timing along a fixed path (the classic phase-plane method, discretised): with
+// x = sigma_dot^2, the path acceleration x' / 2 = sigma_ddot enters every limit linearly,
+//   planar:  | p_ss x + p_s x' / 2 |_xy <= a_max,   yaw:  | yaw_ss x + yaw_s x' / 2 | <= wa_max,
+// the speed limits bound x alone (|p_s|_xy^2 x <= v_max^2, yaw_s^2 x <= w_max^2), and so does the
+// existence of an admissible x' (the maximum velocity curve: at a corner the normal acceleration
+// p_ss x alone reaches a_max). A backward pass from rest at the end then a forward pass from rest
+// at the start, each step taking the largest admissible |x'|, give the fastest x along sigma;
+// time follows from t' = 1 / sigma_dot.
+void BsplineTrajectory::retime(const RobotModel& robot, int samples_per_knot, double margin) {
+  w_t_.clear();
+  w_u_.clear();
+  w_s_.clear();
+  w_sd_.clear();
+  if (empty()) return;
+  margin = std::clamp(margin, 0.1, 1.0);
+  const double vmax = margin * std::max(robot.max_speed_mps, 1e-3);
+  const double wmax = margin * std::max(robot.max_yaw_rate_rps, 1e-3);
+  const double amax = margin * std::max(robot.max_accel_mps2, 1e-3);
+  const double wamax = margin * std::max(robot.max_yaw_accel_rps2, 1e-3);
+  const int knots = int(ctrl_.size()) - 3;
+  const int K = knots * std::max(1, samples_per_knot);  // intervals
+  std::vector<PathDerivs> d(size_t(K) + 1);
+  std::vector<uint8_t> moving(size_t(K) + 1);
+  w_u_.resize(size_t(K) + 1);
+  w_s_.assign(size_t(K) + 1, 0.0);
+  for (int k = 0; k <= K; ++k) {
+    w_u_[k] = double(knots) * k / K;
+    moving[k] = path_derivs(geometry(w_u_[k]), d[k]);
+  }
+  // sigma by Simpson's rule on d sigma / du.
+  for (int k = 0; k < K; ++k) {
+    PathDerivs mid;
+    path_derivs(geometry(0.5 * (w_u_[k] + w_u_[k + 1])), mid);
+    w_s_[k + 1] =
+        w_s_[k] + (w_u_[k + 1] - w_u_[k]) / 6 * (d[k].sigma_u + 4 * mid.sigma_u + d[k + 1].sigma_u);
+  }
+  // Admissible x' at sample k for x: [lo, hi]; empty (lo > hi) if none.
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  auto admissible = [&](int k, double x) -> std::pair<double, double> {
+    double lo = -kInf, hi = kInf;
+    const Eigen::Vector2d P = d[k].p_ss.head<2>() * x, Q = 0.5 * d[k].p_s.head<2>();
+    const double q2 = Q.squaredNorm();
+    if (q2 < 1e-18) {
+      if (P.norm() > amax) return {1, -1};
+    } else {
+      const double pq = P.dot(Q), disc = pq * pq - q2 * (P.squaredNorm() - amax * amax);
+      if (disc < 0) return {1, -1};
+      lo = std::max(lo, (-pq - std::sqrt(disc)) / q2);
+      hi = std::min(hi, (-pq + std::sqrt(disc)) / q2);
+    }
+    const double yp = d[k].yaw_ss * x, yq = 0.5 * d[k].yaw_s;
+    if (std::abs(yq) < 1e-9) {
+      if (std::abs(yp) > wamax) return {1, -1};
+    } else {
+      const double e1 = (-wamax - yp) / yq, e2 = (wamax - yp) / yq;
+      lo = std::max(lo, std::min(e1, e2));
+      hi = std::min(hi, std::max(e1, e2));
+    }
+    return {lo, hi};
+  };
+  // The maximum velocity curve: the speed limits, then the largest x with an admissible x'
+  // (the admissible (x, x') set is convex and holds (0, 0), so its x form an interval).
+  // Where the curve stands still, or its direction turns between two samples by more than the
+  // sampled curvature says (the turn sits between them), the bound comes from that turn.
+  std::vector<double> mvc(size_t(K) + 1, 0.0);
+  const double a_turn = std::min(amax, kYawLength * wamax);
+  for (int k = 0; k <= K; ++k) {
+    if (!moving[k]) continue;  // at rest
+    double cap = 1e6;
+    const double vxy = d[k].p_s.head<2>().squaredNorm(), vy = d[k].yaw_s * d[k].yaw_s;
+    if (vxy > 0) cap = std::min(cap, vmax * vmax / vxy);
+    if (vy > 0) cap = std::min(cap, wmax * wmax / vy);
+    auto dir = [&](int j) {
+      return Eigen::Vector3d(d[j].p_s.x(), d[j].p_s.y(), kYawLength * d[j].yaw_s);
+    };
+    for (int j : {k - 1, k + 1}) {
+      if (j < 0 || j > K || !moving[j]) continue;
+      const double ds = std::abs(w_s_[j] - w_s_[k]);
+      const double turn = std::acos(std::clamp(dir(j).dot(dir(k)), -1.0, 1.0));
+      if (turn > 1e-6) cap = std::min(cap, a_turn * ds / turn);
+    }
+    auto ok = [&](double x) {
+      const auto [lo, hi] = admissible(k, x);
+      return lo <= hi;
+    };
+    if (ok(cap)) {
+      mvc[k] = cap;
+      continue;
+    }
+    double a = 0, b = cap;
+    for (int it = 0; it < 40; ++it) (ok(0.5 * (a + b)) ? a : b) = 0.5 * (a + b);
+    mvc[k] = a;
+  }
+  // Backward pass (deceleration into the end's rest), then forward (acceleration from the
+  // start's). A step's x' is the tighter of its two ends' bounds.
+  std::vector<double> x(size_t(K) + 1, 0.0);
+  x[K] = 0;
+  for (int k = K - 1; k >= 0; --k) {
+    const double ds = w_s_[k + 1] - w_s_[k];
+    double dec = -admissible(k + 1, x[k + 1]).first;  // largest deceleration, > 0
+    if (!(dec > 0)) dec = 0;
+    double cand = std::min(mvc[k], x[k + 1] + dec * ds);
+    const double dec0 = -admissible(k, cand).first;
+    if (dec0 >= 0 && dec0 < dec) cand = std::min(cand, x[k + 1] + dec0 * ds);
+    x[k] = std::max(0.0, cand);
+  }
+  double prev = 0;
+  for (int k = 0; k <= K; ++k) {
+    if (k == 0) {
+      x[0] = 0;
+    } else {
+      const double ds = w_s_[k] - w_s_[k - 1];
+      double acc = admissible(k - 1, prev).second;
+      if (!(acc > 0)) acc = 0;
+      double cand = std::min(x[k], prev + acc * ds);
+      const double acc1 = admissible(k, cand).second;
+      if (acc1 >= 0 && acc1 < acc) cand = std::min(cand, prev + acc1 * ds);
+      x[k] = std::max(0.0, cand);
+    }
+    prev = x[k];
+  }
+  w_sd_.resize(size_t(K) + 1);
+  for (int k = 0; k <= K; ++k) w_sd_[k] = std::sqrt(x[k]);
+  w_t_.assign(size_t(K) + 1, 0.0);
+  for (int k = 0; k < K; ++k) {
+    const double ds = w_s_[k + 1] - w_s_[k], v = w_sd_[k] + w_sd_[k + 1];
+    // Both ends at rest with length between them (two stopping points one sample apart): start
+    // and stop within the interval.
+    const double dt = ds <= 0 ? 0.0 : v > 1e-9 ? 2 * ds / v : 2 * std::sqrt(ds / a_turn);
+    w_t_[k + 1] = w_t_[k] + dt;
+  }
 }
 
 bool TrajectoryBuilder::segment_ok(const map::MapView& view, CollisionChecker& checker,
@@ -257,7 +459,9 @@ BsplineTrajectory TrajectoryBuilder::fit(std::span<const Eigen::Vector3d> wp,
   for (int q = 0; q + 1 < nc; ++q) dt = std::max(dt, std::abs(y[q + 1] - y[q]) / wmax);
   for (int q = 0; q + 2 < nc; ++q)
     dt = std::max(dt, std::sqrt(std::abs(y[q + 2] - 2 * y[q + 1] + y[q]) / wamax));
-  return BsplineTrajectory(std::move(c), std::move(y), dt * (1 + 1e-9), t0);
+  BsplineTrajectory t(std::move(c), std::move(y), dt * (1 + 1e-9), t0);
+  if (opt_.retime) t.retime(robot_);
+  return t;
 }
 
 TrajectoryResult TrajectoryBuilder::build(const map::MapView& view, CollisionChecker& checker,

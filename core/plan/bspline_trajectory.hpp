@@ -12,6 +12,8 @@
 //      |P_{i+1} - P_i|_xy / dt <= v_max,  |P_{i+2} - 2 P_{i+1} + P_i|_xy / dt^2 <= a_max,
 //    and the same for yaw with the yaw-rate / yaw-acceleration limits. By the convex-hull
 //    property of B-spline derivatives this bounds speed and acceleration everywhere on the curve.
+//    Or (TrajectoryOptions::retime) the same curve re-timed: the fastest speed profile along it
+//    within the same four limits, at rest at both ends (BsplineTrajectory::retime).
 // 4. Collision repair: the curve is sampled at the checker's spacing; where the body hits, the
 //    nearest polyline vertex is pinned (tripled control point: the curve passes through it and
 //    follows the polyline there); after max_repairs, every vertex is pinned (the polyline itself).
@@ -48,22 +50,55 @@ class BsplineTrajectory {
   bool empty() const { return ctrl_.size() < 4; }
   double t_start() const { return t0_; }
   double t_end() const { return t0_ + duration(); }
-  double duration() const { return empty() ? 0.0 : double(ctrl_.size() - 3) * dt_; }
+  double duration() const {
+    return empty() ? 0.0 : retimed() ? w_t_.back() : double(ctrl_.size() - 3) * dt_;
+  }
   double knot_interval() const { return dt_; }
   // Position, velocity, yaw at time t (clamped to [t_start, t_end]).
   TrajectorySample sample(double t_s) const;
   BodyPose pose(double t_s) const;
   const std::vector<Eigen::Vector3d>& control_points() const { return ctrl_; }
   const std::vector<double>& yaw_control_points() const { return yaw_; }
-  // Convex-hull bounds of |v|_xy and |a|_xy over the whole curve.
+  // Convex-hull bounds of |v|_xy and |a|_xy over the whole curve (re-timed: the largest |v|_xy
+  // at the re-timing's samples).
   double speed_bound_mps() const;
   double accel_bound_mps2() const;
 
+  // Re-times the same curve: one knot interval for the whole curve lets its sharpest corner set
+  // the speed of every straight metre (a right angle at 0.5 m spacing: 0.59 m/s under a 1 m/s
+  // limit). The curve's shape, and so every collision check of it, is unchanged; only how fast
+  // it is walked: the time-optimal profile along its length (forward-backward integration of
+  // the path acceleration under the planar speed and acceleration limits and the yaw-rate and
+  // yaw-acceleration limits, on samples_per_knot samples per knot interval), at rest at both
+  // ends and wherever the curve stops (a pinned vertex). Limits are used at `margin` of their
+  // value (the profile is exact at the samples only).
+  void retime(const RobotModel& robot, int samples_per_knot = 16, double margin = 0.97);
+  bool retimed() const { return !w_t_.empty(); }
+
  private:
+  // The curve's position and yaw and their derivatives in the knot parameter u at u.
+  struct Geometry {
+    Eigen::Vector3d p, p_u, p_uu;
+    double yaw, yaw_u, yaw_uu;
+    int segment;
+  };
+  Geometry geometry(double u) const;
+  // The same derivatives with respect to the re-timing's path parameter sigma (planar length
+  // and yaw at kYawLength metres per radian); false where the curve stands still (d sigma / du
+  // = 0: the direction is undefined, the curve is at rest there).
+  struct PathDerivs {
+    Eigen::Vector3d p_s, p_ss;
+    double yaw_s, yaw_ss, sigma_u;
+  };
+  bool path_derivs(const Geometry& g, PathDerivs& d) const;
+
   std::vector<Eigen::Vector3d> ctrl_;
   std::vector<double> yaw_;
   double dt_ = 1.0;
   double t0_ = 0;
+  // Re-timing (empty: uniform time, u = (t - t0) / dt): per sample, the time since t0, the knot
+  // parameter u, the path parameter sigma and its rate d sigma / dt.
+  std::vector<double> w_t_, w_u_, w_s_, w_sd_;
 };
 
 struct TrajectoryOptions {
@@ -74,6 +109,8 @@ struct TrajectoryOptions {
   // The spacing is halved into every sharp corner (up to three times), so one corner does not
   // slow the whole curve (one knot interval) below what its straight parts allow.
   bool grade_corners = false;
+  // The curve re-timed (BsplineTrajectory::retime): each part as fast as the limits allow there.
+  bool retime = false;
 };
 
 enum class TrajectoryStatus : uint8_t {

@@ -191,6 +191,7 @@ ExplorationResult ExplorationPlanner::plan_cycle(const ExplorationInput& in) {
   li.robot_yaw_rad = in.robot_yaw_rad;
   li.robot_velocity_mps = in.robot_velocity_mps;
   li.t_s = in.t_s;
+  li.trajectory_lag_s = in.trajectory_lag_s;
   bool zones_left = false;
   // An escape or a climb under way is driven to its end before guidance picks a zone (a climb
   // onto a landing ends on the new floor, where the prior is built on arrival).

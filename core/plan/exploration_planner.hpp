@@ -43,7 +43,8 @@ struct ExplorationInput {
   const std::vector<graph::ClusterViewpoints>* viewpoints = nullptr;
   Eigen::Vector3d robot_foot_m = Eigen::Vector3d::Zero();  // ground point under the robot [m]
   double robot_yaw_rad = 0;
-  double t_s = 0;  // now, on the trajectory's time base [s]
+  double t_s = 0;               // now, on the trajectory's time base [s]
+  double trajectory_lag_s = 0;  // LocalPlanInput::trajectory_lag_s
   Eigen::Vector2d robot_velocity_mps = Eigen::Vector2d::Zero();  // planar, world frame [m/s]
   // Map regions changed since the previous plan() call (e.g. the map task's MapChangeDetector
   // boxes, merged over the versions in between). nullptr: unknown; then every hypothesis within

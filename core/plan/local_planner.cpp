@@ -226,7 +226,7 @@ void LocalPlanner::adopt_target(const LocalPlanInput& in, const graph::FrontierC
   // held the walk far below the speed limit (office seed 1: 0.56 m/s while walking, session 20).
   if (periodic_ && c.id == target_cluster_ && !current_.empty() && !out.trajectory.empty()) {
     const double brake_s = in.robot_velocity_mps.norm() / std::max(robot_.max_accel_mps2, 1e-3);
-    const double left_s = current_.t_end() - in.t_s;
+    const double left_s = current_.t_end() - on_trajectory_s(in);
     if (left_s <= brake_s + out.trajectory.duration() + kFasterMarginS) {
       has_target_ = true;
       remember_target(in, c);
@@ -395,8 +395,9 @@ void LocalPlanner::brake_start(const LocalPlanInput& in) {
   // On the trajectory followed: from its point nearest the robot (within 0.3 m), d of arc on.
   if (!current_.empty()) {
     double s0 = NAN, best = 0.3;
-    for (double s = std::max(current_.t_start(), in.t_s - 2.0);
-         s <= std::min(current_.t_end(), in.t_s + 2.0); s += 0.02) {
+    const double now = on_trajectory_s(in);
+    for (double s = std::max(current_.t_start(), now - 2.0);
+         s <= std::min(current_.t_end(), now + 2.0); s += 0.02) {
       const double e = (current_.sample(s).p_m - in.robot_foot_m).head<2>().norm();
       if (e < best) best = e, s0 = s;
     }
@@ -938,6 +939,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   if (has_target_) {
     const graph::FrontierCluster* tc = track_target(in);
     const double dxy = (in.robot_foot_m - target_m_).head<2>().norm();
+    const double t_on = on_trajectory_s(in);
     // A flight's foot (and with flight_foot the foot of a climb left for last) is reached where
     // the climb can start: on it, or a second after the trajectory's end (the robot trails its
     // reference). (Back at a climb left for last "reached" 0.42 m short, 0.74 m before the first
@@ -945,13 +947,13 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     // with flight_foot, session 16.)
     const bool at_foot = flight_target || (climb_start_ && plan_opt_.flight_foot);
     const bool reached =
-        (at_foot ? dxy <= 0.15 || (in.t_s >= current_.t_end() + 1.0 && dxy <= opt_.reached_radius_m)
+        (at_foot ? dxy <= 0.15 || (t_on >= current_.t_end() + 1.0 && dxy <= opt_.reached_radius_m)
                  : dxy <= opt_.reached_radius_m) &&
         std::abs(in.robot_foot_m.z() - target_m_.z()) < 0.5;
     // An escape or a climb runs to its end (a climb stopped half a metre short of its landing
     // leaves the body's rear over the flight).
-    if (committed_ && (in.t_s >= current_.t_end() || dxy <= 0.1)) {
-      reason = in.t_s > current_.t_end() + 3.0 ? "escape or climb overdue" : "escape or climb done";
+    if (committed_ && (t_on >= current_.t_end() || dxy <= 0.1)) {
+      reason = t_on > current_.t_end() + 3.0 ? "escape or climb overdue" : "escape or climb done";
       has_target_ = committed_ = false;
     } else if (climb_start_ && reached) {
       climb_start_ = false;
@@ -976,7 +978,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
       set_aside_cluster(in, *tc, SetAsideReason::kStillFrontierAtTarget);
       reason = "climb left for last: other frontiers on this floor first";
       has_target_ = false;
-    } else if (!committed_ && (reached || in.t_s > current_.t_end() + 3.0)) {
+    } else if (!committed_ && (reached || t_on > current_.t_end() + 3.0)) {
       if (climb_start_) deferred_climb_.reset();  // overdue on the way back to it: given up
       // Stood at the viewpoint (or should have long ago) and the cluster is still there. First
       // walk onto the frontier itself (the LiDAR's blind ring moves with the robot, so the
@@ -1006,7 +1008,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
       // answer (a pose grazing a nosing at the ground tolerance flipped between grids and the
       // same trajectory was planned, dropped and planned again forever).
       const auto pose_at = [&](double t) { return current_.pose(t); };
-      const double t_from = std::clamp(in.t_s, current_.t_start(), current_.t_end());
+      const double t_from = std::clamp(t_on, current_.t_start(), current_.t_end());
       const CollisionHit hit =
           plan_opt_.climb_blind
               ? checker_.check_on_grid(*in.view, pose_at, current_.t_start(), current_.t_end(),

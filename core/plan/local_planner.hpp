@@ -51,6 +51,10 @@ struct LocalPlanInput {
   Eigen::Vector3d robot_foot_m = Eigen::Vector3d::Zero();  // ground point under the robot [m]
   double robot_yaw_rad = 0;
   double t_s = 0;  // now, on the trajectory's time base [s]
+  // How long the control task has held the reference of the trajectory it follows (the last one
+  // planned) back while the robot caught up (a turn onto it, a safety stop) [s]: that
+  // trajectory's own clock reads t_s - trajectory_lag_s.
+  double trajectory_lag_s = 0;
   Eigen::Vector2d robot_velocity_mps = Eigen::Vector2d::Zero();  // planar, world frame [m/s]
   std::optional<Eigen::Vector3d> anchor_m;  // c_anc from the macro layer (Stage 1 terminal)
   // The last call of a cycle, over every cluster: with nothing else left, clusters set aside for
@@ -231,6 +235,11 @@ class LocalPlanner {
   // PlanOptions::no_progress_s: true once the robot stood that long with a target (then the
   // clock starts again).
   bool no_progress(const LocalPlanInput& in);
+  // Now on the followed trajectory's own clock (LocalPlanInput::trajectory_lag_s): its end
+  // passed means the reference reached its end, not that its planned duration has elapsed.
+  static double on_trajectory_s(const LocalPlanInput& in) {
+    return in.t_s - std::max(0.0, in.trajectory_lag_s);
+  }
   // PlanOptions::stale_floor_s: true once the graph has not grown for that long.
   bool floor_stale(const LocalPlanInput& in);
   void brake_start(const LocalPlanInput& in);  // PlanOptions::brake_start: moves start_foot_m_

@@ -39,6 +39,7 @@ inline TrajectoryOptions trajectory_options(const PlanOptions& o) {
   t.control_spacing_m = o.traj_control_spacing_m;
   t.max_repairs = o.traj_max_repairs;
   t.grade_corners = o.traj_grade_corners;
+  t.retime = o.traj_retime;
   t.reachable_only = o.astar_reachable_only;
   return t;
 }

@@ -28,6 +28,7 @@ struct PlanOptions {
   double traj_control_spacing_m = 0.5;  // control point spacing along the pruned path
   int traj_max_repairs = 8;             // pinned vertices before the polyline fallback
   bool traj_grade_corners = false;      // spacing halved into sharp corners (one dt per curve)
+  bool traj_retime = false;             // time-optimal speed profile along the curve
   // FCL look-ahead of the control task (collision_checker.hpp).
   double lookahead_s = 1.0;  // T: check the next T seconds of the trajectory
   // Macro layer (Sec. IV-A..C; exploration_planner.hpp).
@@ -94,6 +95,9 @@ struct PlanOptions {
   // the old one before entering a new one that turns away (house seed 3: a new target behind the
   // robot, the body turned while overshooting its start into the stairwell's railing).
   bool brake_start = false;
+  // The planner judges the followed trajectory's end on its reference's own clock
+  // (LocalPlanInput::trajectory_lag_s, from the control task), not on its planned duration.
+  bool reference_clock = false;
   bool incremental_maintenance = true;
 };
 

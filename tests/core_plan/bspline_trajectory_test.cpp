@@ -43,7 +43,8 @@ int count_body_intrusions(const map::MapView& view, const BsplineTrajectory& t,
   return hits;
 }
 
-void expect_limits(const BsplineTrajectory& t, const RobotModel& robot) {
+// tol: relative excess allowed (a re-timed curve meets its limits exactly at its samples only).
+void expect_limits(const BsplineTrajectory& t, const RobotModel& robot, double tol = 1e-9) {
   double vmax = 0, amax = 0, wmax = 0;
   for (double s = t.t_start(); s <= t.t_end(); s += 0.005) {
     const TrajectorySample q = t.sample(s);
@@ -51,19 +52,22 @@ void expect_limits(const BsplineTrajectory& t, const RobotModel& robot) {
     amax = std::max(amax, q.a_mps2.head<2>().norm());
     wmax = std::max(wmax, std::abs(q.yaw_rate_rps));
   }
-  EXPECT_LE(vmax, robot.max_speed_mps + 1e-9);
-  EXPECT_LE(amax, robot.max_accel_mps2 + 1e-9);
-  EXPECT_LE(wmax, robot.max_yaw_rate_rps + 1e-9);
-  EXPECT_LE(t.speed_bound_mps(), robot.max_speed_mps + 1e-9);
+  EXPECT_LE(vmax, robot.max_speed_mps * (1 + tol));
+  EXPECT_LE(amax, robot.max_accel_mps2 * (1 + tol));
+  EXPECT_LE(wmax, robot.max_yaw_rate_rps * (1 + tol));
+  EXPECT_LE(t.speed_bound_mps(), robot.max_speed_mps * (1 + tol));
   EXPECT_GT(vmax, 0.3 * robot.max_speed_mps);  // and not uselessly slow
 }
 
-TEST(BsplineTrajectory, LimitsAndEndpointsOnRandomPolylines) {
+// Both timings: one knot interval for the whole curve, and the curve re-timed.
+class BsplineTiming : public ::testing::TestWithParam<bool> {};
+
+TEST_P(BsplineTiming, LimitsAndEndpointsOnRandomPolylines) {
   // An empty map: no support (no shortcuts) and nothing to hit; the fit alone is tested.
   map::TraversabilityMap empty;
   RobotModel robot;
   CollisionChecker cc(robot, 0.1);
-  TrajectoryBuilder tb(robot);
+  TrajectoryBuilder tb(robot, TrajectoryOptions{.retime = GetParam()});
   std::mt19937 rng(9);
   std::uniform_real_distribution<double> step(-1.5, 1.5), yaw(-M_PI, M_PI);
   for (int trial = 0; trial < 20; ++trial) {
@@ -82,7 +86,8 @@ TEST(BsplineTrajectory, LimitsAndEndpointsOnRandomPolylines) {
     EXPECT_NEAR(b.v_mps.norm(), 0, 1e-9);
     EXPECT_NEAR(std::remainder(a.yaw_rad - y0, 2 * M_PI), 0, 1e-9);
     EXPECT_NEAR(std::remainder(b.yaw_rad - y1, 2 * M_PI), 0, 1e-9);
-    expect_limits(t, robot);
+    EXPECT_EQ(t.retimed(), GetParam());
+    expect_limits(t, robot, GetParam() ? 0.02 : 1e-9);
     // Sampling outside the time range clamps to the ends.
     EXPECT_NEAR((t.sample(-5).p_m - path.front()).norm(), 0, 1e-9);
     EXPECT_NEAR((t.sample(1e9).p_m - path.back()).norm(), 0, 1e-9);
@@ -93,11 +98,12 @@ TEST(BsplineTrajectory, LimitsAndEndpointsOnRandomPolylines) {
 // reaches v_max (the halfway points next to the rest triples; it peaked at 0.71 v_max), a half
 // turn in place reaches most of the yaw-rate limit (it turned at 0.35 of it) and a turn on the
 // way does not slow the walk after it.
-TEST(BsplineTrajectory, StraightWalksAndTurnsInPlaceUseTheLimits) {
+TEST_P(BsplineTiming, StraightWalksAndTurnsInPlaceUseTheLimits) {
   map::TraversabilityMap empty;
   RobotModel robot;
   CollisionChecker cc(robot, 0.1);
-  TrajectoryBuilder tb(robot);
+  TrajectoryBuilder tb(robot, TrajectoryOptions{.retime = GetParam()});
+  const double tol = GetParam() ? 0.02 : 1e-9;
   auto peak = [](const BsplineTrajectory& t) {
     double v = 0, w = 0;
     for (double s = t.t_start(); s <= t.t_end(); s += 0.005) {
@@ -109,7 +115,7 @@ TEST(BsplineTrajectory, StraightWalksAndTurnsInPlaceUseTheLimits) {
   const std::vector<Eigen::Vector3d> line{{0, 0, 0}, {6, 0, 0}};
   const TrajectoryResult walk = tb.build(empty.view(), cc, line, 0.0, 0.0, 0.0);
   ASSERT_EQ(walk.status, TrajectoryStatus::kOk);
-  expect_limits(walk.trajectory, robot);
+  expect_limits(walk.trajectory, robot, tol);
   EXPECT_GT(peak(walk.trajectory).first, 0.95 * robot.max_speed_mps);
   // 6 m from rest to rest: no faster than v_max with the acceleration ramps, not much slower.
   EXPECT_LT(walk.trajectory.duration(), 6.0 / robot.max_speed_mps + 3.0);
@@ -117,15 +123,61 @@ TEST(BsplineTrajectory, StraightWalksAndTurnsInPlaceUseTheLimits) {
   const std::vector<Eigen::Vector3d> here{{0, 0, 0}};
   const TrajectoryResult turn = tb.build(empty.view(), cc, here, 0.0, M_PI, 0.0);
   ASSERT_EQ(turn.status, TrajectoryStatus::kOk);
-  EXPECT_LE(peak(turn.trajectory).second, robot.max_yaw_rate_rps + 1e-9);
+  EXPECT_LE(peak(turn.trajectory).second, robot.max_yaw_rate_rps * (1 + tol));
   EXPECT_GT(peak(turn.trajectory).second, 0.8 * robot.max_yaw_rate_rps);
   EXPECT_LT(turn.trajectory.duration(), 2.0 * M_PI / robot.max_yaw_rate_rps);
 
   // Facing away from the walk: the turn at the start, then the walk at v_max.
   const TrajectoryResult back = tb.build(empty.view(), cc, line, M_PI, 0.0, 0.0);
   ASSERT_EQ(back.status, TrajectoryStatus::kOk);
-  expect_limits(back.trajectory, robot);
+  expect_limits(back.trajectory, robot, tol);
   EXPECT_GT(peak(back.trajectory).first, 0.95 * robot.max_speed_mps);
+}
+
+INSTANTIATE_TEST_SUITE_P(UniformAndRetimed, BsplineTiming, ::testing::Bool(),
+                         [](const auto& info) { return info.param ? "Retimed" : "Uniform"; });
+
+// TrajectoryOptions::retime: the L-shaped walk whose one right-angle corner held every metre of
+// it to 0.84 v_max (one knot interval) keeps its shape to the millimetre, walks its straights at
+// the speed limit, slows for the corner only and arrives sooner, within every limit.
+TEST(BsplineTrajectory, RetimingKeepsTheCurveAndWalksItsStraightsAtTheLimit) {
+  map::TraversabilityMap empty;
+  RobotModel robot;
+  CollisionChecker cc(robot, 0.1);
+  const std::vector<Eigen::Vector3d> ell{{0, 0, 0}, {4, 0, 0}, {4, 4, 0}};
+  const TrajectoryResult plain =
+      TrajectoryBuilder(robot).build(empty.view(), cc, ell, 0.0, std::nullopt, 0.0);
+  const TrajectoryResult fast = TrajectoryBuilder(robot, TrajectoryOptions{.retime = true})
+                                    .build(empty.view(), cc, ell, 0.0, std::nullopt, 0.0);
+  ASSERT_EQ(plain.status, TrajectoryStatus::kOk);
+  ASSERT_EQ(fast.status, TrajectoryStatus::kOk);
+  const BsplineTrajectory &p = plain.trajectory, &f = fast.trajectory;
+  ASSERT_TRUE(f.retimed());
+  ASSERT_FALSE(p.retimed());
+  double peak = 0, at_corner = 1e9, corner_gap = 1e9, off_curve = 0;
+  for (double s = f.t_start(); s <= f.t_end(); s += 0.01) {
+    const TrajectorySample q = f.sample(s);
+    peak = std::max(peak, q.v_mps.head<2>().norm());
+    const double gap = (q.p_m - ell[1]).head<2>().norm();
+    if (gap < corner_gap) corner_gap = gap, at_corner = q.v_mps.head<2>().norm();
+    double nearest = 1e9;  // the plain curve, densely sampled
+    for (double r = p.t_start(); r <= p.t_end(); r += 0.002)
+      nearest = std::min(nearest, (p.sample(r).p_m - q.p_m).norm());
+    off_curve = std::max(off_curve, nearest);
+  }
+  EXPECT_LT(off_curve, 2e-3);
+  EXPECT_GT(peak, 0.95 * robot.max_speed_mps);
+  EXPECT_LT(at_corner, 0.8 * peak);
+  EXPECT_LT(f.duration(), 0.85 * p.duration());
+  expect_limits(f, robot, 0.02);
+  EXPECT_NEAR((f.sample(f.t_end()).p_m - ell.back()).norm(), 0, 1e-9);
+  EXPECT_NEAR(f.sample(f.t_start()).v_mps.norm(), 0, 1e-9);
+  EXPECT_NEAR(f.sample(f.t_end()).v_mps.norm(), 0, 1e-9);
+  // The reported velocity is the derivative of the reported position.
+  for (double s = f.t_start() + 0.05; s < f.t_end() - 0.05; s += 0.37) {
+    const Eigen::Vector3d fd = (f.sample(s + 1e-4).p_m - f.sample(s - 1e-4).p_m) / 2e-4;
+    EXPECT_NEAR((fd - f.sample(s).v_mps).norm(), 0, 0.02) << "t " << s;
+  }
 }
 
 // TrajectoryOptions::grade_corners: one right-angle corner held the whole L-shaped walk (one knot

@@ -16,6 +16,7 @@ TEST(PlanConfig, OptionsFlowIntoComponents) {
   o.astar_reachable_only = false;
   o.traj_control_spacing_m = 0.4;
   o.traj_grade_corners = true;
+  o.traj_retime = true;
   EXPECT_EQ(tsp_options(o).exact_max_n, 9);
   const ViewpointDpOptions d = dp_options(o);
   EXPECT_EQ(d.window_w, 3);
@@ -27,6 +28,7 @@ TEST(PlanConfig, OptionsFlowIntoComponents) {
   EXPECT_DOUBLE_EQ(trajectory_options(o).control_spacing_m, 0.4);
   EXPECT_FALSE(trajectory_options(o).reachable_only);
   EXPECT_TRUE(trajectory_options(o).grade_corners);
+  EXPECT_TRUE(trajectory_options(o).retime);
   o.astar_max_expansions = -5;  // nonsense from a config: still a bounded, non-zero search
   EXPECT_EQ(astar_options(o).max_expansions, 1u);
 }

@@ -479,6 +479,66 @@ TEST(LocalPlanner, AFrontierBesideAFlightSendsTheRobotToTheFlightsFootToClimb) {
   EXPECT_FALSE(run_flight_foot(false).to_foot);
 }
 
+// LocalPlanInput::trajectory_lag_s: the control task's reference waits for the robot (a turn
+// onto the trajectory, a safety stop), so a climb's planned end can pass on the clock with the
+// robot still on the flight. Judged "done" then, the climb stopped 0.7 m short of its landing and
+// the robot turned back down (house seed 1 with a re-timed, faster trajectory, session 21). On
+// the trajectory's own clock it is still under way.
+TEST(LocalPlanner, AClimbWhoseReferenceTrailsTheClockIsNotDoneAtItsPlannedEnd) {
+  Harness h;
+  observe_flight_room(h);
+  PlanOptions po;
+  po.climb_blind = true;
+  po.flight_foot = true;
+  const auto view = h.map.view();
+  const std::vector<storey::core::graph::FrontierCluster> at_foot = clusters_at_foot(h);
+  ASSERT_FALSE(at_foot.empty());
+  for (const bool trailing : {false, true}) {
+    SCOPED_TRACE(trailing ? "reference trailing by 2.5 s" : "no lag reported");
+    LocalPlanner lp(RobotModel{}, po, 0.1);
+    Eigen::Vector3f foot(-2.0f, 1.2f, 0);
+    double yaw = 0, t = 0;
+    BsplineTrajectory climb;
+    for (int cycle = 0; cycle < 12 && climb.empty(); ++cycle) {
+      LocalPlanInput in = input(h, view, foot, t);
+      in.clusters = &at_foot;
+      in.robot_yaw_rad = yaw;
+      in.last_resort = true;
+      const LocalPlanResult r = lp.plan(in);
+      if (r.status != LocalPlanStatus::kNewTrajectory) {
+        t += 1.0;
+        continue;
+      }
+      if (std::string(r.replan_reason).rfind("climb on", 0) == 0) {
+        climb = r.trajectory;
+        break;
+      }
+      const auto end = r.trajectory.pose(r.trajectory.t_end());  // walked to its end
+      foot = end.foot_m.cast<float>();
+      yaw = end.yaw_rad;
+      t = r.trajectory.t_end() + 1.5;
+    }
+    ASSERT_FALSE(climb.empty());
+    ASSERT_TRUE(lp.committed());
+    // Half a second past the planned end, the robot where the reference stands 2.5 s earlier.
+    const BodyPose on = climb.pose(climb.t_end() - 2.5);
+    ASSERT_GT(on.foot_m.z(), 0.3) << "on the flight";
+    LocalPlanInput in = input(h, view, on.foot_m.cast<float>(), climb.t_end() + 0.5);
+    in.clusters = &at_foot;
+    in.robot_yaw_rad = on.yaw_rad;
+    in.trajectory_lag_s = trailing ? 2.5 : 0.0;
+    const LocalPlanResult r = lp.plan(in);
+    if (trailing) {
+      EXPECT_EQ(r.status, LocalPlanStatus::kKeep) << r.replan_reason;
+      EXPECT_TRUE(lp.committed());
+    } else {
+      EXPECT_NE(r.status, LocalPlanStatus::kKeep);
+      EXPECT_STREQ(r.replan_reason, "escape or climb done");
+      EXPECT_FALSE(lp.committed());
+    }
+  }
+}
+
 // A partial climb (nothing seen past the top tread from below) ends on the top tread. There the
 // body pitches up with the flight: every ray passes over the landing's body space, which is never
 // seen at body height (office seed 1, session 15: no node grew on the landing and the run ended
