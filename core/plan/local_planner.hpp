@@ -169,6 +169,10 @@ void keep_first_in_tour(size_t kept, const std::vector<double>& cost, int n, boo
 
 class LocalPlanner {
  public:
+  // LocalPlanInput::trajectory_lag_s counts at most this much: a robot that cannot follow at all
+  // (its body wedged against a wall, the reference waiting for ever) still gets its target
+  // overdue.
+  static constexpr double kMaxReferenceLagS = 10.0;
   LocalPlanner(const RobotModel& robot, const PlanOptions& plan, double voxel_size_m,
                const LocalPlannerOptions& options = {});
   LocalPlanResult plan(const LocalPlanInput& in);
@@ -236,9 +240,10 @@ class LocalPlanner {
   // clock starts again).
   bool no_progress(const LocalPlanInput& in);
   // Now on the followed trajectory's own clock (LocalPlanInput::trajectory_lag_s): its end
-  // passed means the reference reached its end, not that its planned duration has elapsed.
+  // passed means the reference reached its end, not that its planned duration has elapsed. At
+  // most kMaxReferenceLagS behind the clock.
   static double on_trajectory_s(const LocalPlanInput& in) {
-    return in.t_s - std::max(0.0, in.trajectory_lag_s);
+    return in.t_s - std::clamp(in.trajectory_lag_s, 0.0, kMaxReferenceLagS);
   }
   // PlanOptions::stale_floor_s: true once the graph has not grown for that long.
   bool floor_stale(const LocalPlanInput& in);

@@ -493,8 +493,17 @@ TEST(LocalPlanner, AClimbWhoseReferenceTrailsTheClockIsNotDoneAtItsPlannedEnd) {
   const auto view = h.map.view();
   const std::vector<storey::core::graph::FrontierCluster> at_foot = clusters_at_foot(h);
   ASSERT_FALSE(at_foot.empty());
-  for (const bool trailing : {false, true}) {
-    SCOPED_TRACE(trailing ? "reference trailing by 2.5 s" : "no lag reported");
+  // lag: the reported lag; past: the clock past the planned end.
+  struct Case {
+    double lag, past;
+    bool kept;
+  };
+  for (const Case c : {Case{0.0, 0.5, false}, Case{2.5, 0.5, true},
+                       // A robot that cannot follow (the reference waits for ever): still done
+                       // once the clock is kMaxReferenceLagS past the planned end.
+                       Case{30.0, LocalPlanner::kMaxReferenceLagS - 1.0, true},
+                       Case{30.0, LocalPlanner::kMaxReferenceLagS + 1.0, false}}) {
+    SCOPED_TRACE(::testing::Message() << "lag " << c.lag << " s, " << c.past << " s past the end");
     LocalPlanner lp(RobotModel{}, po, 0.1);
     Eigen::Vector3f foot(-2.0f, 1.2f, 0);
     double yaw = 0, t = 0;
@@ -520,15 +529,15 @@ TEST(LocalPlanner, AClimbWhoseReferenceTrailsTheClockIsNotDoneAtItsPlannedEnd) {
     }
     ASSERT_FALSE(climb.empty());
     ASSERT_TRUE(lp.committed());
-    // Half a second past the planned end, the robot where the reference stands 2.5 s earlier.
+    // Past the planned end, the robot where the reference stands 2.5 s earlier.
     const BodyPose on = climb.pose(climb.t_end() - 2.5);
     ASSERT_GT(on.foot_m.z(), 0.3) << "on the flight";
-    LocalPlanInput in = input(h, view, on.foot_m.cast<float>(), climb.t_end() + 0.5);
+    LocalPlanInput in = input(h, view, on.foot_m.cast<float>(), climb.t_end() + c.past);
     in.clusters = &at_foot;
     in.robot_yaw_rad = on.yaw_rad;
-    in.trajectory_lag_s = trailing ? 2.5 : 0.0;
+    in.trajectory_lag_s = c.lag;
     const LocalPlanResult r = lp.plan(in);
-    if (trailing) {
+    if (c.kept) {
       EXPECT_EQ(r.status, LocalPlanStatus::kKeep) << r.replan_reason;
       EXPECT_TRUE(lp.committed());
     } else {

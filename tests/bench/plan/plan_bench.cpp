@@ -130,7 +130,7 @@ void BM_PlanTrajectory(benchmark::State& st) {
   }
   RobotModel robot;
   CollisionChecker cc(robot, view.voxel_size_m());
-  TrajectoryBuilder tb(robot);
+  TrajectoryBuilder tb(robot, TrajectoryOptions{.retime = st.range(0) != 0});
   TrajectoryResult r;
   for (auto _ : st) {
     r = tb.build(view, cc, p.points_m, 0.0, M_PI / 2, 0.0);
@@ -142,7 +142,38 @@ void BM_PlanTrajectory(benchmark::State& st) {
   st.counters["duration_s"] = r.trajectory.duration();
   st.SetItemsProcessed(st.iterations());
 }
-BENCHMARK(BM_PlanTrajectory)->Unit(benchmark::kMillisecond)->Iterations(5);
+// retime:1 = TrajectoryOptions::retime (the same curve, time-optimal profile).
+BENCHMARK(BM_PlanTrajectory)
+    ->ArgName("retime")
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(5);
+
+// One sample of the built trajectory (the control task's reference each period, the look-ahead's
+// poses): uniform time against the re-timed table's lookup.
+void BM_PlanTrajectorySample(benchmark::State& st) {
+  const map::MapView view = building().map.view();
+  VoxelAStar astar;
+  const VoxelPath p = astar.plan(view, {-17.5, 0, 0}, {-7.5, 5.5, 0});
+  if (p.status != VoxelAStarStatus::kOk) {
+    st.SkipWithError(to_string(p.status));
+    return;
+  }
+  RobotModel robot;
+  CollisionChecker cc(robot, view.voxel_size_m());
+  const TrajectoryResult r = TrajectoryBuilder(robot, TrajectoryOptions{.retime = st.range(0) != 0})
+                                 .build(view, cc, p.points_m, 0.0, M_PI / 2, 0.0);
+  const BsplineTrajectory& t = r.trajectory;
+  double s = t.t_start();
+  for (auto _ : st) {
+    benchmark::DoNotOptimize(t.sample(s).p_m.x());
+    s = s > t.t_end() ? t.t_start() : s + 0.013;
+  }
+  st.counters["duration_s"] = t.duration();
+  st.SetItemsProcessed(st.iterations());
+}
+BENCHMARK(BM_PlanTrajectorySample)->ArgName("retime")->Arg(0)->Arg(1)->Unit(benchmark::kNanosecond);
 
 void BM_PlanLookahead(benchmark::State& st) {
   const map::MapView view = building().map.view();
