@@ -59,6 +59,14 @@ void expect_limits(const BsplineTrajectory& t, const RobotModel& robot, double t
   EXPECT_GT(vmax, 0.3 * robot.max_speed_mps);  // and not uselessly slow
 }
 
+// An L-shaped walk, 4 m then a right angle and 4 m, built in an empty map with `options`.
+const std::vector<Eigen::Vector3d> kEll{{0, 0, 0}, {4, 0, 0}, {4, 4, 0}};
+TrajectoryResult build_ell(const RobotModel& robot, const TrajectoryOptions& options = {}) {
+  map::TraversabilityMap empty;
+  CollisionChecker cc(robot, 0.1);
+  return TrajectoryBuilder(robot, options).build(empty.view(), cc, kEll, 0.0, std::nullopt, 0.0);
+}
+
 // Both timings: one knot interval for the whole curve, and the curve re-timed.
 class BsplineTiming : public ::testing::TestWithParam<bool> {};
 
@@ -141,14 +149,10 @@ INSTANTIATE_TEST_SUITE_P(UniformAndRetimed, BsplineTiming, ::testing::Bool(),
 // it to 0.84 v_max (one knot interval) keeps its shape to the millimetre, walks its straights at
 // the speed limit, slows for the corner only and arrives sooner, within every limit.
 TEST(BsplineTrajectory, RetimingKeepsTheCurveAndWalksItsStraightsAtTheLimit) {
-  map::TraversabilityMap empty;
   RobotModel robot;
-  CollisionChecker cc(robot, 0.1);
-  const std::vector<Eigen::Vector3d> ell{{0, 0, 0}, {4, 0, 0}, {4, 4, 0}};
-  const TrajectoryResult plain =
-      TrajectoryBuilder(robot).build(empty.view(), cc, ell, 0.0, std::nullopt, 0.0);
-  const TrajectoryResult fast = TrajectoryBuilder(robot, TrajectoryOptions{.retime = true})
-                                    .build(empty.view(), cc, ell, 0.0, std::nullopt, 0.0);
+  const std::vector<Eigen::Vector3d>& ell = kEll;
+  const TrajectoryResult plain = build_ell(robot);
+  const TrajectoryResult fast = build_ell(robot, TrajectoryOptions{.retime = true});
   ASSERT_EQ(plain.status, TrajectoryStatus::kOk);
   ASSERT_EQ(fast.status, TrajectoryStatus::kOk);
   const BsplineTrajectory &p = plain.trajectory, &f = fast.trajectory;
@@ -184,20 +188,16 @@ TEST(BsplineTrajectory, RetimingKeepsTheCurveAndWalksItsStraightsAtTheLimit) {
 // interval) to 0.84 v_max; with the spacing halved into the corner the straight parts reach v_max
 // and the curve slows for the corner only, within every limit.
 TEST(BsplineTrajectory, GradedCornersLetTheStraightsReachTheSpeedLimit) {
-  map::TraversabilityMap empty;
   RobotModel robot;
-  CollisionChecker cc(robot, 0.1);
-  const std::vector<Eigen::Vector3d> ell{{0, 0, 0}, {4, 0, 0}, {4, 4, 0}};
+  const std::vector<Eigen::Vector3d>& ell = kEll;
   auto peak_speed = [](const BsplineTrajectory& t) {
     double v = 0;
     for (double s = t.t_start(); s <= t.t_end(); s += 0.005)
       v = std::max(v, t.sample(s).v_mps.head<2>().norm());
     return v;
   };
-  const TrajectoryResult plain =
-      TrajectoryBuilder(robot).build(empty.view(), cc, ell, 0.0, std::nullopt, 0.0);
-  const TrajectoryResult graded = TrajectoryBuilder(robot, TrajectoryOptions{.grade_corners = true})
-                                      .build(empty.view(), cc, ell, 0.0, std::nullopt, 0.0);
+  const TrajectoryResult plain = build_ell(robot);
+  const TrajectoryResult graded = build_ell(robot, TrajectoryOptions{.grade_corners = true});
   ASSERT_EQ(plain.status, TrajectoryStatus::kOk);
   ASSERT_EQ(graded.status, TrajectoryStatus::kOk);
   EXPECT_LT(peak_speed(plain.trajectory), 0.9 * robot.max_speed_mps);  // 0.84
