@@ -15,8 +15,7 @@ TEST(ExploreRamp, ReachesAndExploresTheUpperFloorSafely) {
   EXPECT_EQ(m.falls, 0u);
   ASSERT_EQ(m.floors_total, 2);
   ASSERT_EQ(m.per_floor.size(), 2u);
-  // Measured 0.947 / 0.916, complete at 482.5 s (seed 1, session 21, re-timed trajectories; seeds
-  // 2-4: upper floor 0.903 / 0.422 / 0.904). Session 18: 0.918 / 0.945 at 515.5 s (seeds 2-4: 0.921
+  // Measured 0.918 / 0.945, complete at 515.5 s (seed 1, session 18; seeds 2-4: upper floor 0.921
   // / 0.863 / 0.945). Session 12: 0.938 / 0.730 at 596.5 s (seeds 2-4: 0.929 / 0.935 / 0.944;
   // docs/RESULTS.md). Session 11: 0.845 / 0.930 (0.916 / 0.916 with the session
   // 9-11 switches off). Earlier: 0.893 / 0.900 at 600 s. Since stair nosings are step edges

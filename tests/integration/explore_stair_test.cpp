@@ -26,8 +26,7 @@ void expect_both_floors_safely(const SimRunResult& r) {
 TEST(ExploreStair, AClimbStoppedOnTheFlightGoesOnUpAndTheRunEndsComplete) {
   const SimRunResult r = run_exploration(quiet_run("test_stair", 1, 300));
   const RunMetrics& m = r.metrics;
-  // Measured (seed 1, session 21, re-timed trajectories): complete at 172.0 s, floors 0.888 /
-  // 0.849. Session 18: complete at 135.0 s, floors 0.884 / 0.847. With flight_foot,
+  // Measured (seed 1, session 18): complete at 135.0 s, floors 0.884 / 0.847. With flight_foot,
   // near a climb deferred beside the flight but facing away, it walks to the deferral's pose
   // again (session 17 dropped it there and ended at 86.5 s with the upper floor at 0.0). Session
   // 12 (before flight_foot): 85.5 s, 0.858 / 0.811. Before that: the climb
@@ -45,8 +44,7 @@ TEST(ExploreStair, AClimbStoppedOnTheFlightGoesOnUpAndTheRunEndsComplete) {
 // "complete" with the upper floor at 18.4 % (session 16). Now that ground is entered only where
 // the robot walks level or a climb has ended on its landing (firmware/blind_support.hpp).
 TEST(ExploreStair, TheNarrowLandingIsEnteredAtItsOwnHeight) {
-  // Measured (seed 2, session 21, re-timed trajectories): complete at 104.5 s, floors 0.879 /
-  // 0.873. Session 18: complete at 142.0 s, floors 0.892 / 0.872 (session 17,
+  // Measured (seed 2, session 18): complete at 142.0 s, floors 0.892 / 0.872 (session 17,
   // flight_foot alone: 148.0 s, 0.893 / 0.847).
   expect_both_floors_safely(run_exploration(quiet_run("test_stair", 2, 300)));
 }
