@@ -60,7 +60,7 @@ class BsplineTrajectory {
   const std::vector<Eigen::Vector3d>& control_points() const { return ctrl_; }
   const std::vector<double>& yaw_control_points() const { return yaw_; }
   // Convex-hull bounds of |v|_xy and |a|_xy over the whole curve (re-timed: the largest |v|_xy
-  // at the re-timing's samples).
+  // at the re-timing's samples, the largest |a|_xy sampled every 10 ms).
   double speed_bound_mps() const;
   double accel_bound_mps2() const;
 
