@@ -83,6 +83,7 @@ void read_map(SectionReader&& r, core::map::MapOptions& o) {
   r.get("log_odds_occupied", o.log_odds_occupied, Range{-10.0, 10.0});
   r.get("n_min", o.n_min, Range{1, 1000});
   r.get("spill_is_surface", o.spill_is_surface);
+  r.get("miss_needs_crossing", o.miss_needs_crossing);
   r.get("neighbourhood_radius_m", o.neighbourhood_radius_m, Range{0.01, 5.0});
   r.get("neighbourhood_dz_m", o.neighbourhood_dz_m, Range{0.0, 2.0});
   r.get("n_ref", o.n_ref, Range{1, 100000});
@@ -160,6 +161,7 @@ void read_plan(SectionReader&& r, core::plan::PlanOptions& o) {
   r.get("traj_max_repairs", o.traj_max_repairs, Range{0, 1000});
   r.get("traj_grade_corners", o.traj_grade_corners);
   r.get("traj_retime", o.traj_retime);
+  r.get("traj_retime_yaw_share", o.traj_retime_yaw_share, Range{0.1, 1.0});
   r.get("lookahead_s", o.lookahead_s, Range{0.1, 10.0});
   r.get("floor_stable_s", o.floor_stable_s, Range{0.0, 60.0});
   r.get("floor_stable_band_m", o.floor_stable_band_m, Range{0.01, 1.0});

@@ -478,7 +478,7 @@ void Autonomy::control_step() {
            s += 0.05)
         starts_ahead = (old_t.sample(s).p_m - p0).head<2>().norm() < 0.1;
     }
-    if (starts_ahead && v.norm() > 0.2 && ControlLaw::turns_away(tv.ptr->trajectory, v)) {
+    if (starts_ahead && v.norm() > 0.2 && law_.turns_away(tv.ptr->trajectory, v)) {
       if (!pending_) brake_k_ = 1.0, brake_v0_ = v.norm();
       pending_ = tv.ptr;
     } else {

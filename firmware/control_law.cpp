@@ -72,13 +72,30 @@ Eigen::Vector2d ControlLaw::rest_point(const PoseSample& pose) const {
   return Eigen::Vector2d(pose.x_m, pose.y_m) + v * v.norm() / two_a;
 }
 
-bool ControlLaw::turns_away(const core::plan::BsplineTrajectory& t, const Eigen::Vector2d& v) {
+bool ControlLaw::turns_away(const core::plan::BsplineTrajectory& t,
+                            const Eigen::Vector2d& v) const {
   if (t.empty() || v.norm() < 1e-6) return false;
-  const double t1 = std::min(t.t_end(), t.t_start() + 1.0);
-  const auto a = t.sample(t.t_start()), b = t.sample(t1);
-  if (std::abs(wrap_angle(b.yaw_rad - a.yaw_rad)) > 0.5) return true;
-  const Eigen::Vector2d d = (b.p_m - a.p_m).head<2>();
-  return d.norm() > 0.05 && d.normalized().dot(v.normalized()) < 0.5;
+  // Judged along the path, not its clock: a re-timed trajectory leaves its start at the
+  // acceleration limit, and one turning in place barely moved in its first second (maze seed 1,
+  // 1030 s: entered at 0.97 m/s, the body overshot into a wall). The look distance is what the
+  // robot covers while it falls in behind a reference that starts at rest.
+  const double look = v.squaredNorm() / std::max(robot_.max_accel_mps2, 1e-3) + 0.3;
+  const Eigen::Vector2d u = v.normalized();
+  const core::plan::TrajectorySample a = t.sample(t.t_start());
+  Eigen::Vector2d prev = a.p_m.head<2>();
+  double walked = 0;
+  for (double s = t.t_start() + 0.05;; s += 0.05) {
+    const double sc = std::min(s, t.t_end());
+    const core::plan::TrajectorySample b = t.sample(sc);
+    if (std::abs(wrap_angle(b.yaw_rad - a.yaw_rad)) > 0.5) return true;
+    const Eigen::Vector2d chord = (b.p_m - a.p_m).head<2>(), dir = b.v_mps.head<2>();
+    if (chord.norm() > 0.05 && chord.normalized().dot(u) < 0.5) return true;
+    if (dir.norm() > 0.05 && dir.normalized().dot(u) < 0.5) return true;
+    walked += (b.p_m.head<2>() - prev).norm();
+    prev = b.p_m.head<2>();
+    if (walked >= look) return false;
+    if (sc >= t.t_end()) return true;  // it ends within reach: the robot would overshoot its end
+  }
 }
 
 double ControlLaw::entry_time(const core::plan::BsplineTrajectory& t, const Eigen::Vector2d& at) {

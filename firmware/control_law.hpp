@@ -41,11 +41,12 @@ class ControlLaw {
   // planner started it: entered while moving, a trajectory that turns back passes the robot's
   // position later, and tracking from there cut the turn short into a railing (house seed 2).
   static double entry_time(const core::plan::BsplineTrajectory& t, const Eigen::Vector2d& at);
-  // A new trajectory that leaves its start more than 60 deg off the robot's velocity v (world
-  // frame), or turns the body more than 0.5 rad within its first second: the robot brakes on the
-  // trajectory it follows before it enters this one (plan.brake_start). One that carries on
-  // along v is entered at once (a stop at every replan would halve the speed).
-  static bool turns_away(const core::plan::BsplineTrajectory& t, const Eigen::Vector2d& v);
+  // A new trajectory that, within twice the robot's stopping distance + 0.3 m of path (judged
+  // along the curve, whatever its timing), heads more than 60 deg off the robot's velocity v
+  // (world frame), turns the body more than 0.5 rad, or ends: the robot brakes on the trajectory
+  // it follows before it enters this one (plan.brake_start). One that carries on along v is
+  // entered at once (a stop at every replan would halve the speed).
+  bool turns_away(const core::plan::BsplineTrajectory& t, const Eigen::Vector2d& v) const;
   // Clamps a command to speed / yaw-rate limits and rate-limits it against prev (exposed for
   // tests).
   VelocityCommand limit(VelocityCommand cmd, const VelocityCommand& prev, double dt_s) const;

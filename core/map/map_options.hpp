@@ -16,6 +16,12 @@ struct MapOptions {
   // N_min low over a level, well-observed floor is that floor's spill across a voxel boundary,
   // judged as a surface.
   bool spill_is_surface = false;
+  // Beyond the paper (map.miss_needs_crossing): a ray counts against an occupied voxel whose points
+  // lie on a plane only if it crosses that plane inside the voxel. Rays down a corridor pass a few
+  // centimetres in front of its walls, within the points' spread, and freed the walls seen from
+  // afar; C_exp probes then left through them and frontiers came and went with the robot's
+  // distance (test_ramp seed 1, session 22).
+  bool miss_needs_crossing = false;
   // --- occupancy (ray casting) ---
   double voxel_size_m = 0.1;    // map resolution
   double max_range_m = 30.0;    // rays beyond this are truncated (free space only, no endpoint)

@@ -2,11 +2,14 @@
 
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 
+#include "core/map/point_plane.hpp"
 #include "core/map/voxel_ray.hpp"
 
 namespace storey::core::map {
@@ -146,8 +149,54 @@ InsertStats TraversabilityMap::insert_scan(const Eigen::Vector3f& o,
   // Saarinen et al. 2013). Otherwise grazing rays over a floor would erode the floor voxels,
   // whose points fill only the bottom of the voxel.
   Eigen::Vector3d ray_dir;  // unit, world frame, set per ray below
+  // MapOptions::miss_needs_crossing: whether the ray crosses, inside voxel k, the plane through
+  // `mean` (world) with normal `nrm`.
+  auto crosses_in_voxel = [&](const VoxelKey& k, const Eigen::Vector3d& mean,
+                              const Eigen::Vector3d& nrm) {
+    const Eigen::Vector3d od = o.cast<double>();
+    const int32_t kk[3] = {k.x, k.y, k.z};
+    double t0 = 0, t1 = std::numeric_limits<double>::infinity();  // the ray inside the voxel
+    for (int a = 0; a < 3; ++a) {
+      if (std::abs(ray_dir[a]) < 1e-12) continue;
+      double ta = (kk[a] * s - od[a]) / ray_dir[a], tb = ((kk[a] + 1) * s - od[a]) / ray_dir[a];
+      if (ta > tb) std::swap(ta, tb);
+      t0 = std::max(t0, ta), t1 = std::min(t1, tb);
+    }
+    if (!(t1 >= t0)) return true;  // numerically at a corner: counted, as without the option
+    return nrm.dot(od + t0 * ray_dir - mean) * nrm.dot(od + t1 * ray_dir - mean) <= 0.0;
+  };
+  // Under 3 points of its own (a wall's far part, seen once or twice): the plane of its points
+  // pooled with its 26 neighbours' (at least 6 points in all); none or no clear plane: counted.
+  auto crosses_pooled_plane = [&](const VoxelKey& k) {
+    double n = 0;
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d m2 = Eigen::Matrix3d::Zero(), outer = Eigen::Matrix3d::Zero();
+    for (int32_t dx = -1; dx <= 1; ++dx)
+      for (int32_t dy = -1; dy <= 1; ++dy)
+        for (int32_t dz = -1; dz <= 1; ++dz) {
+          const VoxelKey q{k.x + dx, k.y + dy, k.z + dz};
+          const VoxelStats* st = rstats(q);
+          if (!st || st->count == 0) continue;
+          const Eigen::Vector3d m((q.x + 0.5) * s + st->mean[0], (q.y + 0.5) * s + st->mean[1],
+                                  (q.z + 0.5) * s + st->mean[2]);
+          n += st->count;
+          sum += st->count * m;
+          m2 += scatter(*st);
+          outer += st->count * m * m.transpose();
+        }
+    if (n < 6) return true;
+    const Eigen::Vector3d mean = sum / n;
+    const PointPlane pl = plane_of_scatter(m2 + outer - n * mean * mean.transpose(), n);
+    return !clear_plane(pl) || crosses_in_voxel(k, mean, pl.normal);
+  };
+  // A ray crossing an occupied voxel only counts as a miss if it passes through the voxel's
+  // point distribution (Mahalanobis distance <= 3 from the points' Gaussian, as in NDT-OM,
+  // Saarinen et al. 2013). Otherwise grazing rays over a floor would erode the floor voxels,
+  // whose points fill only the bottom of the voxel. With miss_needs_crossing, points on a plane
+  // count a ray only if it crosses the plane in the voxel: rays down a corridor pass within the
+  // points' spread in front of its walls without meeting them.
   auto ray_meets_points = [&](const VoxelKey& k, const VoxelStats& vs) {
-    if (vs.count < 3) return true;
+    if (vs.count < 3) return !opt_.miss_needs_crossing || crosses_pooled_plane(k);
     const Eigen::Vector3d mean((k.x + 0.5) * s + vs.mean[0], (k.y + 0.5) * s + vs.mean[1],
                                (k.z + 0.5) * s + vs.mean[2]);
     const Eigen::Vector3d rel = mean - o.cast<double>();
@@ -156,7 +205,10 @@ InsertStats TraversabilityMap::insert_scan(const Eigen::Vector3f& o,
     Eigen::Matrix3d cov;
     cov << vs.m2[0] / n + reg, vs.m2[1] / n, vs.m2[2] / n, vs.m2[1] / n, vs.m2[3] / n + reg,
         vs.m2[4] / n, vs.m2[2] / n, vs.m2[4] / n, vs.m2[5] / n + reg;
-    return delta.dot(cov.inverse() * delta) <= 9.0;  // closed-form 3x3 inverse
+    if (delta.dot(cov.inverse() * delta) > 9.0) return false;  // closed-form 3x3 inverse
+    if (!opt_.miss_needs_crossing) return true;
+    const PointPlane pl = point_plane(vs);
+    return !clear_plane(pl) || crosses_in_voxel(k, mean, pl.normal);
   };
   // Pass 2: free space along each de-duplicated ray.
   const int early_stop = opt_.ray_early_stop_voxels;

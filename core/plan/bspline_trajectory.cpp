@@ -168,17 +168,19 @@ double BsplineTrajectory::accel_bound_mps2() const {
 // p_ss x alone reaches a_max). A backward pass from rest at the end then a forward pass from rest
 // at the start, each step taking the largest admissible |x'|, give the fastest x along sigma;
 // time follows from t' = 1 / sigma_dot.
-void BsplineTrajectory::retime(const RobotModel& robot, int samples_per_knot, double margin) {
+void BsplineTrajectory::retime(const RobotModel& robot, int samples_per_knot, double margin,
+                               double yaw_margin) {
   w_t_.clear();
   w_u_.clear();
   w_s_.clear();
   w_sd_.clear();
   if (empty()) return;
   margin = std::clamp(margin, 0.1, 1.0);
+  yaw_margin = yaw_margin > 0 ? std::clamp(yaw_margin, 0.1, 1.0) : margin;
   const double vmax = margin * std::max(robot.max_speed_mps, 1e-3);
-  const double wmax = margin * std::max(robot.max_yaw_rate_rps, 1e-3);
+  const double wmax = yaw_margin * std::max(robot.max_yaw_rate_rps, 1e-3);
   const double amax = margin * std::max(robot.max_accel_mps2, 1e-3);
-  const double wamax = margin * std::max(robot.max_yaw_accel_rps2, 1e-3);
+  const double wamax = yaw_margin * std::max(robot.max_yaw_accel_rps2, 1e-3);
   const int knots = int(ctrl_.size()) - 3;
   const int K = knots * std::max(1, samples_per_knot);  // intervals
   std::vector<PathDerivs> d(size_t(K) + 1);
@@ -460,7 +462,7 @@ BsplineTrajectory TrajectoryBuilder::fit(std::span<const Eigen::Vector3d> wp,
   for (int q = 0; q + 2 < nc; ++q)
     dt = std::max(dt, std::sqrt(std::abs(y[q + 2] - 2 * y[q + 1] + y[q]) / wamax));
   BsplineTrajectory t(std::move(c), std::move(y), dt * (1 + 1e-9), t0);
-  if (opt_.retime) t.retime(robot_);
+  if (opt_.retime) t.retime(robot_, 16, 0.97, opt_.retime_yaw_share);
   return t;
 }
 

@@ -162,6 +162,10 @@ int LocalPlanner::expire_set_aside(const LocalPlanInput& in) {
 bool LocalPlanner::retry_from_elsewhere(const LocalPlanInput& in, LocalPlanResult& out) {
   if (!in.last_resort || plan_opt_.path_retries <= 0 || robot_node_ >= sg_.num_nodes())
     return false;
+  // Just after a climb the new floor's graph is still growing and its frontiers have no path
+  // yet: a retry then went for the failures left below and walked back down the flight
+  // (test_stair seed 1, session 22).
+  if (climb_done_s_ >= 0 && in.t_s - climb_done_s_ < opt_.climb_settle_s) return false;
   auto eligible = [&](const SetAsideEntry& e) {
     return (e.reason == SetAsideReason::kAstarFailed ||
             e.reason == SetAsideReason::kTrajectoryFailed) &&
@@ -964,9 +968,9 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
         return commit_climb("climb on: the floor is done, up the flight left for last");
       reason = "back at a flight left for last: no climb from here";
       has_target_ = false;
-    } else if (!committed_ && !climb_start_ && reached && tc &&
+    } else if (!committed_ && !climb_start_ && reached && (tc || flight_target) &&
                try_climb(false, flight_target ? &flight_foot_ : nullptr)) {
-      const int others = other_targets(in, tc->id);
+      const int others = other_targets(in, tc ? tc->id : -1);
       if (others == 0)
         return commit_climb("climb on: a frontier on a flight is not seen from on it");
       if (climb_deferrals_ >= opt_.max_climb_deferrals)
@@ -975,7 +979,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
       // floor is nearly done (office seed 1 climbed at 30 % coverage, floor 0 never finished).
       if (!plan_opt_.flight_foot || others <= opt_.climb_deferral_max_others) ++climb_deferrals_;
       defer_climb();  // other frontiers first: the climb is one way
-      set_aside_cluster(in, *tc, SetAsideReason::kStillFrontierAtTarget);
+      if (tc) set_aside_cluster(in, *tc, SetAsideReason::kStillFrontierAtTarget);
       reason = "climb left for last: other frontiers on this floor first";
       has_target_ = false;
     } else if (!committed_ && (reached || t_on > current_.t_end() + 3.0)) {
@@ -997,7 +1001,9 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
       }
       reason = reached ? "target reached" : "target overdue";
       has_target_ = false;
-    } else if (!tc && !committed_ && !climb_start_) {
+    } else if (!tc && !committed_ && !climb_start_ && !flight_target) {
+      // (A flight's foot is walked to even so: its frontier is often seen on the way, and the
+      // climb from there is what reaches the floor above; teaching_building seed 1, session 22.)
       reason = "target cluster observed";
       has_target_ = false;
     } else {

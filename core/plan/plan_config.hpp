@@ -40,6 +40,7 @@ inline TrajectoryOptions trajectory_options(const PlanOptions& o) {
   t.max_repairs = o.traj_max_repairs;
   t.grade_corners = o.traj_grade_corners;
   t.retime = o.traj_retime;
+  t.retime_yaw_share = o.traj_retime_yaw_share;
   t.reachable_only = o.astar_reachable_only;
   return t;
 }

@@ -29,6 +29,7 @@ struct PlanOptions {
   int traj_max_repairs = 8;             // pinned vertices before the polyline fallback
   bool traj_grade_corners = false;      // spacing halved into sharp corners (one dt per curve)
   bool traj_retime = false;             // time-optimal speed profile along the curve
+  double traj_retime_yaw_share = 0.97;  // ... using this share of the yaw-rate and -accel limits
   // FCL look-ahead of the control task (collision_checker.hpp).
   double lookahead_s = 1.0;  // T: check the next T seconds of the trajectory
   // Macro layer (Sec. IV-A..C; exploration_planner.hpp).

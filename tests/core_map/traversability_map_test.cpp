@@ -264,3 +264,63 @@ TEST(TraversabilityMap, EarlyStopRayCastingIsASubsetOfExact) {
   EXPECT_EQ(fast_not_exact, 0u);
   EXPECT_GE(free_fast, free_exact * 85 / 100) << free_fast << " of " << free_exact;
 }
+
+// MapOptions::miss_needs_crossing. A corridor's walls seen from close by, then 20 scans from
+// 4-8 m before its end, looking down it: rays to the walls' far parts pass within a few
+// centimetres of the nearer wall voxels, inside their points' spread, and without the option
+// they free them (test_ramp seed 1: the ramp's side walls freed from its foot, C_exp probes left
+// through them and the frontiers came and went with the robot's distance). With it a wall voxel
+// is freed only by rays crossing its plane: a door panel taken away is still cleared.
+namespace {
+std::vector<VoxelKey> wall_face_voxels(const TraversabilityMap& m) {  // the occupied ones
+  std::vector<VoxelKey> occ;
+  for (float x = 8.05f; x < 18.f; x += 0.1f)
+    for (float z = 0.35f; z < 2.0f; z += 0.1f)
+      for (const float y : {0.75f, -0.75f})
+        if (m.view().occupancy(Vector3f(x, y, z)) == Occupancy::kOccupied)
+          occ.push_back(m.view().key_of(Vector3f(x, y, z)));
+  return occ;
+}
+}  // namespace
+
+TEST(TraversabilityMap, RaysDownACorridorDoNotFreeItsWallsButADoorTakenAwayIsCleared) {
+  storey::test::World w;
+  using storey::test::aabb;
+  w.add(aabb({-10, -1, -0.2f}, {20, 1, 0}));         // floor
+  w.add(aabb({-10, -1.2f, 0}, {20, -0.75f, 2.5f}));  // walls 1.5 m apart
+  w.add(aabb({-10, 0.75f, 0}, {20, 1.2f, 2.5f}));
+  w.add(aabb({-10.2f, -1, 0}, {-10, 1, 2.5f}));  // its end wall
+  storey::test::World shut = w;
+  shut.add(aabb({-3, -0.75f, 0}, {-2.9f, 0.75f, 2.0f}));  // a door panel across it
+  for (const bool on : {false, true}) {
+    SCOPED_TRACE(on ? "map.miss_needs_crossing on" : "off");
+    MapOptions o;  // defaults (30 m range, early-stop ray casting), as the robot runs them
+    o.miss_needs_crossing = on;
+    TraversabilityMap m(o);
+    for (const float x : {6.f, 9.f, 12.f, 15.f, 18.f})
+      m.insert_scan(Vector3f(x, 0, 0.55f),
+                    storey::test::scan_vlp16(w, Vector3f(x, 0, 0.55f), 0.f, uint32_t(x)));
+    const std::vector<VoxelKey> walls = wall_face_voxels(m);
+    ASSERT_GT(walls.size(), 2000u);
+    for (int k = 0; k < 20; ++k) {
+      const Vector3f sensor(-4.f + 0.2f * k, 0.1f * float(k % 3), 0.55f);
+      m.insert_scan(sensor,
+                    storey::test::scan_vlp16(w, sensor, 0.01f * float(k), uint32_t(100 + k)));
+    }
+    size_t freed = 0;  // of the wall voxels the near scans left occupied
+    for (const VoxelKey& k : walls) freed += m.view().occupancy(k) != Occupancy::kOccupied;
+    if (on)
+      EXPECT_LT(freed, walls.size() / 40);
+    else  // (12 % of them: the case the option is for)
+      EXPECT_GT(freed, walls.size() / 10) << "the walls were not freed: the test shows nothing";
+    // The panel, seen shut from the near side, then open.
+    const Vector3f at(-1.5f, 0, 0.55f);
+    for (uint32_t k = 0; k < 3; ++k)
+      m.insert_scan(at, storey::test::scan_vlp16(shut, at, 0.f, 200 + k));
+    const Vector3f panel(-2.95f, 0.05f, 0.55f);
+    ASSERT_EQ(m.view().occupancy(panel), Occupancy::kOccupied);
+    for (uint32_t k = 0; k < 10; ++k)
+      m.insert_scan(at, storey::test::scan_vlp16(w, at, 0.f, 300 + k));
+    EXPECT_EQ(m.view().occupancy(panel), Occupancy::kFree);
+  }
+}

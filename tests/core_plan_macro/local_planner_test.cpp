@@ -223,8 +223,9 @@ LocalPlanResult periodic_replan(bool only_if_faster, bool walked) {
   }
   const LocalPlanResult r1 = lp.plan(in);
   EXPECT_EQ(r1.target_cluster, r0.target_cluster);
-  if (r1.status == LocalPlanStatus::kNewTrajectory && walked)
+  if (r1.status == LocalPlanStatus::kNewTrajectory && walked) {
     EXPECT_LT(r1.trajectory.t_end(), r0.trajectory.t_end() - 1.0);  // arrives earlier
+  }
   return r1;
 }
 
@@ -477,6 +478,46 @@ TEST(LocalPlanner, AFrontierBesideAFlightSendsTheRobotToTheFlightsFootToClimb) {
   EXPECT_NEAR(on.foot_yaw, 0.0, 0.15);  // facing up the flight
   EXPECT_TRUE(on.climbed);
   EXPECT_FALSE(run_flight_foot(false).to_foot);
+}
+
+// The frontier beside a flight is often seen on the way to its foot: the robot walks on to the
+// foot even so, and climbs from there (teaching_building seed 1, session 22: trips to a flight's
+// foot were dropped as "target cluster observed" within 2.5 s, each foot is tried once, and the
+// upper floor was never reached).
+TEST(LocalPlanner, AFlightsFootIsWalkedToAndClimbedFromAfterItsFrontierWasSeen) {
+  Harness h;
+  observe_flight_room(h);
+  PlanOptions po;
+  po.climb_blind = po.flight_foot = true;
+  const auto view = h.map.view();
+  LocalPlanner lp(RobotModel{}, po, 0.1);
+  Eigen::Vector3f foot(-2.0f, 1.2f, 0);
+  double yaw = 0, t = 0;
+  const std::vector<storey::core::graph::FrontierCluster> at_foot = clusters_at_foot(h), none;
+  ASSERT_FALSE(at_foot.empty());
+  std::optional<LocalPlanResult> to_foot;
+  for (int cycle = 0; cycle < 12 && !to_foot; ++cycle)
+    if (auto r = walked_cycle(lp, h, view, at_foot, foot, yaw, t);
+        r && std::string(r->replan_reason).rfind("to a flight's foot", 0) == 0)
+      to_foot = std::move(r);
+  ASSERT_TRUE(to_foot);
+  // Half way there the cluster is gone: the trip goes on.
+  const BsplineTrajectory& tr = to_foot->trajectory;
+  const double t_mid = 0.5 * (tr.t_start() + tr.t_end());
+  LocalPlanInput mid = input(h, view, tr.pose(t_mid).foot_m.cast<float>(), t_mid);
+  mid.clusters = &none;
+  mid.robot_yaw_rad = tr.pose(t_mid).yaw_rad;
+  mid.last_resort = true;
+  EXPECT_EQ(lp.plan(mid).status, LocalPlanStatus::kKeep);
+  // At the foot: up the flight (no other frontier left on this floor: climbed at once).
+  LocalPlanInput at = input(h, view, foot, t);
+  at.clusters = &none;
+  at.robot_yaw_rad = yaw;
+  at.last_resort = true;
+  const LocalPlanResult climb = lp.plan(at);
+  ASSERT_EQ(climb.status, LocalPlanStatus::kNewTrajectory);
+  EXPECT_EQ(std::string(climb.replan_reason).rfind("climb on", 0), 0u) << climb.replan_reason;
+  EXPECT_GT(climb.trajectory.pose(climb.trajectory.t_end()).foot_m.z(), 0.5);
 }
 
 // LocalPlanInput::trajectory_lag_s: the control task's reference waits for the robot (a turn

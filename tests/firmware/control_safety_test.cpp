@@ -114,13 +114,49 @@ TEST(ControlLaw, ANewTrajectoryIsEnteredNearestWhereTheRobotComesToRest) {
   // It leaves its start against the robot's velocity: the robot brakes on the trajectory it
   // follows first. One carrying on along the velocity is entered at once; one turning the body
   // in place at its start is not.
-  EXPECT_TRUE(ControlLaw::turns_away(t, {0.0, 0.8}));
-  EXPECT_FALSE(ControlLaw::turns_away(t, {0.0, -0.8}));
-  EXPECT_FALSE(ControlLaw::turns_away(t, {0.3, -0.8}));
+  EXPECT_TRUE(law.turns_away(t, {0.0, 0.8}));
+  EXPECT_FALSE(law.turns_away(t, {0.0, -0.8}));
+  EXPECT_FALSE(law.turns_away(t, {0.3, -0.8}));
   std::vector<double> turning(ctrl.size(), M_PI / 2);
   turning[2] = turning[3] = turning[4] = -0.5;
   const core::plan::BsplineTrajectory turn(ctrl, turning, 1.0, 10.0);
-  EXPECT_TRUE(ControlLaw::turns_away(turn, {0.0, -0.8}));
+  EXPECT_TRUE(law.turns_away(turn, {0.0, -0.8}));
+}
+
+// Judged along the curve, not its clock: a re-timed trajectory leaves its start at rest at the
+// acceleration limit, so its first second covers under 0.5 m and a bend just beyond went unseen
+// (maze seed 1, 1030 s: entered at 0.97 m/s, the body overshot 0.45 m into a wall).
+TEST(ControlLaw, ANewTrajectoryThatBendsWithinTheRobotsReachIsBrakedInto) {
+  core::RobotModel robot;
+  ControlLaw law(robot);
+  const auto retimed = [&](std::vector<Eigen::Vector3d> path) {
+    std::vector<Eigen::Vector3d> ctrl{path.front(), path.front()};
+    for (size_t i = 0; i + 1 < path.size(); ++i)  // 0.25 m spacing, the ends clamped
+      for (double k = 0; k < 1.0; k += 0.25 / (path[i + 1] - path[i]).norm())
+        ctrl.push_back(path[i] + k * (path[i + 1] - path[i]));
+    ctrl.insert(ctrl.end(), 3, path.back());
+    std::vector<double> yaw;
+    for (size_t i = 0; i < ctrl.size(); ++i) {
+      const Eigen::Vector3d d = ctrl[std::min(i + 1, ctrl.size() - 1)] - ctrl[i > 0 ? i - 1 : 0];
+      yaw.push_back(d.head<2>().norm() > 1e-9 ? std::atan2(d.y(), d.x()) : 0.0);
+    }
+    for (size_t i = 1; i < yaw.size(); ++i)  // continuous, as the planner's
+      yaw[i] = yaw[i - 1] + wrap_angle(yaw[i] - yaw[i - 1]);
+    core::plan::BsplineTrajectory t(ctrl, yaw, 0.5, 0.0);
+    t.retime(robot);
+    return t;
+  };
+  const Eigen::Vector2d v(0.97, 0.0);  // walking east at the speed limit
+  // East for 0.6 m, then north: the bend is reached after the first second.
+  const auto bend = retimed({{0, 0, 0}, {0.6, 0, 0}, {0.6, 3, 0}});
+  ASSERT_TRUE(bend.retimed());
+  EXPECT_LT((bend.sample(bend.t_start() + 1.0).p_m - bend.sample(bend.t_start()).p_m).norm(), 0.55);
+  EXPECT_TRUE(law.turns_away(bend, v));
+  // Straight on for 3 m: entered at once. The same walk ending 0.5 m on: braked into.
+  EXPECT_FALSE(law.turns_away(retimed({{0, 0, 0}, {3, 0, 0}}), v));
+  EXPECT_TRUE(law.turns_away(retimed({{0, 0, 0}, {0.5, 0, 0}}), v));
+  // Slow enough to fall in behind the reference within 0.6 m: the bend is out of reach.
+  EXPECT_FALSE(law.turns_away(bend, {0.4, 0.0}));
 }
 
 TEST(ControlLaw, FeedforwardInBodyFrameAndNanGuard) {
