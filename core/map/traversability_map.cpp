@@ -187,7 +187,16 @@ InsertStats TraversabilityMap::insert_scan(const Eigen::Vector3f& o,
     if (n < 6) return true;
     const Eigen::Vector3d mean = sum / n;
     const PointPlane pl = plane_of_scatter(m2 + outer - n * mean * mean.transpose(), n);
-    return !clear_plane(pl) || crosses_in_voxel(k, mean, pl.normal);
+    if (!clear_plane(pl)) return true;
+    // Its own points on that plane (not a stray return above a floor, which a ray passing over
+    // the floor would otherwise never clear).
+    const VoxelStats* own = rstats(k);
+    if (!own || own->count == 0) return true;
+    const Eigen::Vector3d m((k.x + 0.5) * s + own->mean[0], (k.y + 0.5) * s + own->mean[1],
+                            (k.z + 0.5) * s + own->mean[2]);
+    if (std::abs(pl.normal.dot(m - mean)) > std::max(0.02, 3.0 * std::sqrt(pl.eigenvalues[0])))
+      return true;
+    return crosses_in_voxel(k, mean, pl.normal);
   };
   // A ray crossing an occupied voxel only counts as a miss if it passes through the voxel's
   // point distribution (Mahalanobis distance <= 3 from the points' Gaussian, as in NDT-OM,

@@ -60,10 +60,11 @@ MapOptions bench_options() {
   return o;
 }
 
-void insert_storey(benchmark::State& state, bool vlp16, bool exact = false) {
+void insert_storey(benchmark::State& state, bool vlp16, bool exact = false, bool crossing = false) {
   const ScanSet& set = scans(vlp16);
   MapOptions o = bench_options();
   if (exact) o.ray_early_stop_voxels = 0;  // every voxel of every ray, like OctoMap
+  o.miss_needs_crossing = crossing;        // map.miss_needs_crossing
   TraversabilityMap map(o);
   size_t i = 0, points = 0;
   for (auto _ : state) {
@@ -107,6 +108,13 @@ void BM_map_insert_mid360_exact(benchmark::State& s) {
 }
 void BM_map_insert_mid360_storey(benchmark::State& s) {
   insert_storey(s, false);
+}
+// map.miss_needs_crossing: the plane tests of occupied voxels a ray meets.
+void BM_map_insert_vlp16_crossing(benchmark::State& s) {
+  insert_storey(s, true, false, true);
+}
+void BM_map_insert_mid360_crossing(benchmark::State& s) {
+  insert_storey(s, false, false, true);
 }
 void BM_map_insert_mid360_octomap(benchmark::State& s) {
   insert_octomap(s, false);
@@ -196,6 +204,12 @@ BENCHMARK(BM_map_insert_mid360_octomap)
     ->Name("map_insert_mid360/octomap")
     ->Unit(benchmark::kMillisecond)
     ->Iterations(33);
+BENCHMARK(BM_map_insert_vlp16_crossing)
+    ->Name("map_insert_vlp16/storey_crossing")
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_map_insert_mid360_crossing)
+    ->Name("map_insert_mid360/storey_crossing")
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_map_insert_vlp16_exact)
     ->Name("map_insert_vlp16/storey_exact")
     ->Unit(benchmark::kMillisecond);
