@@ -480,6 +480,47 @@ TEST(LocalPlanner, AFrontierBesideAFlightSendsTheRobotToTheFlightsFootToClimb) {
   EXPECT_FALSE(run_flight_foot(false).to_foot);
 }
 
+// An open flight (treads without risers): from its foot the floor under the flight shows between
+// the treads, right past the last tread seen. That is not a landing's edge but treads not seen
+// yet: the climb goes up to the last support seen (a partial climb) instead of being dropped
+// (teaching_building seed 1, session 22: every climb from a foot ended there).
+TEST(LocalPlanner, FromTheFootOfAnOpenFlightTheClimbGoesUpToTheLastTreadSeen) {
+  World w;
+  w.add({-4, -3, -0.2f}, {6, 3, 0});  // the floor, also under the flight
+  for (int i = 0; i < 12; ++i)        // 4 cm treads, open risers
+    w.add({0.3f * float(i), -0.6f, 0.15f * float(i + 1) - 0.04f},
+          {0.3f * float(i + 1), 0.6f, 0.15f * float(i + 1)});
+  w.add({0, -0.72f, 0}, {3.6f, -0.6f, 2.5f});
+  w.add({0, 0.6f, 0}, {3.6f, 0.72f, 2.5f});
+  w.add({-4, -3.2f, 0}, {6, -3, 2.5f});  // the room's walls
+  w.add({-4, 3, 0}, {6, 3.2f, 2.5f});
+  w.add({-4.2f, -3, 0}, {-4, 3, 2.5f});
+  Harness h;
+  h.observe(w, {-2.0f, 1.2f, 0}, 40000, 1);
+  h.observe(w, {-1.5f, -1.5f, 0}, 40000, 2);
+  PlanOptions po;
+  po.climb_blind = po.flight_foot = true;
+  const auto view = h.map.view();
+  LocalPlanner lp(RobotModel{}, po, 0.1);
+  Eigen::Vector3f foot(-2.0f, 1.2f, 0);
+  double yaw = 0, t = 0;
+  const std::vector<storey::core::graph::FrontierCluster> at_foot = clusters_at_foot(h), none;
+  ASSERT_FALSE(at_foot.empty());
+  bool to_foot = false;
+  for (int cycle = 0; cycle < 12 && !to_foot; ++cycle)
+    if (auto r = walked_cycle(lp, h, view, at_foot, foot, yaw, t))
+      to_foot = std::string(r->replan_reason).rfind("to a flight's foot", 0) == 0;
+  ASSERT_TRUE(to_foot);
+  LocalPlanInput at = input(h, view, foot, t);
+  at.clusters = &none;
+  at.robot_yaw_rad = yaw;
+  at.last_resort = true;
+  const LocalPlanResult climb = lp.plan(at);
+  ASSERT_EQ(climb.status, LocalPlanStatus::kNewTrajectory);
+  EXPECT_EQ(std::string(climb.replan_reason).rfind("climb on", 0), 0u) << climb.replan_reason;
+  EXPECT_GT(climb.trajectory.pose(climb.trajectory.t_end()).foot_m.z(), 0.25);
+}
+
 // The frontier beside a flight is often seen on the way to its foot: the robot walks on to the
 // foot even so, and climbs from there (teaching_building seed 1, session 22: trips to a flight's
 // foot were dropped as "target cluster observed" within 2.5 s, each foot is tried once, and the

@@ -57,7 +57,10 @@ TEST(ExploreHouse, GroundFloorWithTheSwitchesOff) {
                              {"lookahead_on_plan_grid: true ", "lookahead_on_plan_grid: false"},
                              {"keep_reachable_cut: true ", "keep_reachable_cut: false"},
                              {"surface_seen_from_above: true ", "surface_seen_from_above: false"},
-                             {"stale_floor_s: 120.0", "stale_floor_s: 0.0"}});
+                             {"stale_floor_s: 120.0", "stale_floor_s: 0.0"},
+                             {"miss_needs_crossing: true ", "miss_needs_crossing: false"},
+                             {"traj_retime: true ", "traj_retime: false"},
+                             {"reference_clock: true ", "reference_clock: false"}});
   ASSERT_FALSE(o.config.empty()) << "config/default.yaml does not have the switches on";
   const SimRunResult a = run_exploration(o);
   const RunMetrics& m = a.metrics;
