@@ -726,7 +726,7 @@ bool LocalPlanner::climb_on(const LocalPlanInput& in, LocalPlanResult& out, bool
   climb_axis_ = FlightAxis{o, axis->dir, axis->width_m};
   const double yaw = std::atan2(axis->dir.y(), axis->dir.x());
   if (climb_partial_) {
-    if (z - foot.z() < 2 * step) return false;
+    if (z - foot.z() < 2 * step - 0.03) return false;  // (two treads: 0.34 m, 0.337 in the map)
     return straight_walk(in, pts, yaw, out);
   }
   // The longest walk the body fits (its front stops short of a wall), ending at least

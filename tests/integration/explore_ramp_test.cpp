@@ -15,13 +15,14 @@ TEST(ExploreRamp, ReachesAndExploresTheUpperFloorSafely) {
   EXPECT_EQ(m.falls, 0u);
   ASSERT_EQ(m.floors_total, 2);
   ASSERT_EQ(m.per_floor.size(), 2u);
-  // Measured 0.918 / 0.945, complete at 515.5 s (seed 1, session 18; seeds 2-4: upper floor 0.921
-  // / 0.863 / 0.945). Session 12: 0.938 / 0.730 at 596.5 s (seeds 2-4: 0.929 / 0.935 / 0.944;
-  // docs/RESULTS.md). Session 11: 0.845 / 0.930 (0.916 / 0.916 with the session
-  // 9-11 switches off). Earlier: 0.893 / 0.900 at 600 s. Since stair nosings are step edges
-  // (session 5) the robot takes the ramp before floor 0 is done and comes back for it: at 360 s
-  // floor 0 stood at 0.40, floor 1 at 0.91 (before: 0.87 / 0.73, floor 0 first). Before ramps were
-  // centred like level ground the robot never left floor 0.
+  // Measured 0.914 / 0.942, complete at 275.0 s (seed 1, session 22; seeds 2-3: upper floor 0.916 /
+  // 0.947). Session 18: 0.918 / 0.945 at 515.5 s (seeds 2-4: upper floor 0.921 / 0.863 / 0.945).
+  // Session 12: 0.938 / 0.730 at 596.5 s (seeds 2-4: 0.929 / 0.935 / 0.944; docs/RESULTS.md).
+  // Session 11: 0.845 / 0.930 (0.916 / 0.916 with the session 9-11 switches off). Earlier: 0.893 /
+  // 0.900 at 600 s. Since stair nosings are step edges (session 5) the robot takes the ramp before
+  // floor 0 is done and comes back for it: at 360 s floor 0 stood at 0.40, floor 1 at 0.91 (before:
+  // 0.87 / 0.73, floor 0 first). Before ramps were centred like level ground the robot never left
+  // floor 0.
   EXPECT_GE(m.per_floor[0].traversable_coverage, 0.8);
   EXPECT_GE(m.per_floor[1].traversable_coverage, 0.7) << "the upper floor was not explored";
 }
