@@ -480,6 +480,52 @@ TEST(LocalPlanner, AFrontierBesideAFlightSendsTheRobotToTheFlightsFootToClimb) {
   EXPECT_FALSE(run_flight_foot(false).to_foot);
 }
 
+namespace {
+// The robot sent to the foot of h's flight (flight_foot on) from (-2, 1.2): the trip's result,
+// then plan cycles with every frontier gone (`none`, as when it is seen on the way).
+struct FootTrip {
+  const Harness& h;
+  storey::core::map::MapView view;
+  LocalPlanner lp;
+  Eigen::Vector3f foot{-2.0f, 1.2f, 0};
+  double yaw = 0, t = 0;
+  std::vector<storey::core::graph::FrontierCluster> none;
+
+  explicit FootTrip(const Harness& harness)
+      : h(harness), view(harness.map.view()), lp(RobotModel{}, foot_options(), 0.1) {}
+  static PlanOptions foot_options() {
+    PlanOptions po;
+    po.climb_blind = po.flight_foot = true;
+    return po;
+  }
+  // Plan cycles over the foot's clusters until the trip to the foot is planned (walked to its end).
+  std::optional<LocalPlanResult> to_foot() {
+    const std::vector<storey::core::graph::FrontierCluster> at_foot = clusters_at_foot(h);
+    EXPECT_FALSE(at_foot.empty());
+    for (int cycle = 0; cycle < 12; ++cycle)
+      if (auto r = walked_cycle(lp, h, view, at_foot, foot, yaw, t);
+          r && std::string(r->replan_reason).rfind("to a flight's foot", 0) == 0)
+        return r;
+    return std::nullopt;
+  }
+  // One cycle with no frontier left, the robot at p / yaw_p at time t_p.
+  LocalPlanResult without_frontiers(const Eigen::Vector3f& p, double yaw_p, double t_p) {
+    LocalPlanInput in = input(h, view, p, t_p);
+    in.clusters = &none;
+    in.robot_yaw_rad = yaw_p;
+    in.last_resort = true;
+    return lp.plan(in);
+  }
+  // At the foot with no frontier left: a climb, ending higher than min_z_m.
+  void expect_climb_at_foot(double min_z_m) {
+    const LocalPlanResult climb = without_frontiers(foot, yaw, t);
+    ASSERT_EQ(climb.status, LocalPlanStatus::kNewTrajectory);
+    EXPECT_EQ(std::string(climb.replan_reason).rfind("climb on", 0), 0u) << climb.replan_reason;
+    EXPECT_GT(climb.trajectory.pose(climb.trajectory.t_end()).foot_m.z(), min_z_m);
+  }
+};
+}  // namespace
+
 // An open flight (treads without risers): from its foot the floor under the flight shows between
 // the treads, right past the last tread seen. That is not a landing's edge but treads not seen
 // yet: the climb goes up to the last support seen (a partial climb) instead of being dropped
@@ -498,27 +544,9 @@ TEST(LocalPlanner, FromTheFootOfAnOpenFlightTheClimbGoesUpToTheLastTreadSeen) {
   Harness h;
   h.observe(w, {-2.0f, 1.2f, 0}, 40000, 1);
   h.observe(w, {-1.5f, -1.5f, 0}, 40000, 2);
-  PlanOptions po;
-  po.climb_blind = po.flight_foot = true;
-  const auto view = h.map.view();
-  LocalPlanner lp(RobotModel{}, po, 0.1);
-  Eigen::Vector3f foot(-2.0f, 1.2f, 0);
-  double yaw = 0, t = 0;
-  const std::vector<storey::core::graph::FrontierCluster> at_foot = clusters_at_foot(h), none;
-  ASSERT_FALSE(at_foot.empty());
-  bool to_foot = false;
-  for (int cycle = 0; cycle < 12 && !to_foot; ++cycle)
-    if (auto r = walked_cycle(lp, h, view, at_foot, foot, yaw, t))
-      to_foot = std::string(r->replan_reason).rfind("to a flight's foot", 0) == 0;
-  ASSERT_TRUE(to_foot);
-  LocalPlanInput at = input(h, view, foot, t);
-  at.clusters = &none;
-  at.robot_yaw_rad = yaw;
-  at.last_resort = true;
-  const LocalPlanResult climb = lp.plan(at);
-  ASSERT_EQ(climb.status, LocalPlanStatus::kNewTrajectory);
-  EXPECT_EQ(std::string(climb.replan_reason).rfind("climb on", 0), 0u) << climb.replan_reason;
-  EXPECT_GT(climb.trajectory.pose(climb.trajectory.t_end()).foot_m.z(), 0.25);
+  FootTrip trip(h);
+  ASSERT_TRUE(trip.to_foot());
+  trip.expect_climb_at_foot(0.25);
 }
 
 // The frontier beside a flight is often seen on the way to its foot: the robot walks on to the
@@ -528,37 +556,18 @@ TEST(LocalPlanner, FromTheFootOfAnOpenFlightTheClimbGoesUpToTheLastTreadSeen) {
 TEST(LocalPlanner, AFlightsFootIsWalkedToAndClimbedFromAfterItsFrontierWasSeen) {
   Harness h;
   observe_flight_room(h);
-  PlanOptions po;
-  po.climb_blind = po.flight_foot = true;
-  const auto view = h.map.view();
-  LocalPlanner lp(RobotModel{}, po, 0.1);
-  Eigen::Vector3f foot(-2.0f, 1.2f, 0);
-  double yaw = 0, t = 0;
-  const std::vector<storey::core::graph::FrontierCluster> at_foot = clusters_at_foot(h), none;
-  ASSERT_FALSE(at_foot.empty());
-  std::optional<LocalPlanResult> to_foot;
-  for (int cycle = 0; cycle < 12 && !to_foot; ++cycle)
-    if (auto r = walked_cycle(lp, h, view, at_foot, foot, yaw, t);
-        r && std::string(r->replan_reason).rfind("to a flight's foot", 0) == 0)
-      to_foot = std::move(r);
+  FootTrip trip(h);
+  const std::optional<LocalPlanResult> to_foot = trip.to_foot();
   ASSERT_TRUE(to_foot);
   // Half way there the cluster is gone: the trip goes on.
   const BsplineTrajectory& tr = to_foot->trajectory;
   const double t_mid = 0.5 * (tr.t_start() + tr.t_end());
-  LocalPlanInput mid = input(h, view, tr.pose(t_mid).foot_m.cast<float>(), t_mid);
-  mid.clusters = &none;
-  mid.robot_yaw_rad = tr.pose(t_mid).yaw_rad;
-  mid.last_resort = true;
-  EXPECT_EQ(lp.plan(mid).status, LocalPlanStatus::kKeep);
+  EXPECT_EQ(
+      trip.without_frontiers(tr.pose(t_mid).foot_m.cast<float>(), tr.pose(t_mid).yaw_rad, t_mid)
+          .status,
+      LocalPlanStatus::kKeep);
   // At the foot: up the flight (no other frontier left on this floor: climbed at once).
-  LocalPlanInput at = input(h, view, foot, t);
-  at.clusters = &none;
-  at.robot_yaw_rad = yaw;
-  at.last_resort = true;
-  const LocalPlanResult climb = lp.plan(at);
-  ASSERT_EQ(climb.status, LocalPlanStatus::kNewTrajectory);
-  EXPECT_EQ(std::string(climb.replan_reason).rfind("climb on", 0), 0u) << climb.replan_reason;
-  EXPECT_GT(climb.trajectory.pose(climb.trajectory.t_end()).foot_m.z(), 0.5);
+  trip.expect_climb_at_foot(0.5);
 }
 
 // LocalPlanInput::trajectory_lag_s: the control task's reference waits for the robot (a turn
