@@ -6,7 +6,6 @@
 #include <stdexcept>
 #include <string>
 
-#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 
 #include "core/map/point_plane.hpp"
@@ -144,16 +143,12 @@ InsertStats TraversabilityMap::insert_scan(const Eigen::Vector3f& o,
   }
 
   const double ox = o.x() * inv, oy = o.y() * inv, oz = o.z() * inv;
-  // A ray crossing an occupied voxel only counts as a miss if it passes through the voxel's
-  // point distribution (Mahalanobis distance <= 3 from the points' Gaussian, as in NDT-OM,
-  // Saarinen et al. 2013). Otherwise grazing rays over a floor would erode the floor voxels,
-  // whose points fill only the bottom of the voxel.
   Eigen::Vector3d ray_dir;  // unit, world frame, set per ray below
+  const Eigen::Vector3d od = o.cast<double>();
   // MapOptions::miss_needs_crossing: whether the ray crosses, inside voxel k, the plane through
   // `mean` (world) with normal `nrm`.
   auto crosses_in_voxel = [&](const VoxelKey& k, const Eigen::Vector3d& mean,
                               const Eigen::Vector3d& nrm) {
-    const Eigen::Vector3d od = o.cast<double>();
     const int32_t kk[3] = {k.x, k.y, k.z};
     double t0 = 0, t1 = std::numeric_limits<double>::infinity();  // the ray inside the voxel
     for (int a = 0; a < 3; ++a) {
@@ -167,7 +162,7 @@ InsertStats TraversabilityMap::insert_scan(const Eigen::Vector3f& o,
   };
   // Under 3 points of its own (a wall's far part, seen once or twice): the plane of its points
   // pooled with its 26 neighbours' (at least 6 points in all); none or no clear plane: counted.
-  auto crosses_pooled_plane = [&](const VoxelKey& k) {
+  auto crosses_pooled_plane = [&](const VoxelKey& k, const VoxelStats& own) {
     double n = 0;
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     Eigen::Matrix3d m2 = Eigen::Matrix3d::Zero(), outer = Eigen::Matrix3d::Zero();
@@ -190,10 +185,9 @@ InsertStats TraversabilityMap::insert_scan(const Eigen::Vector3f& o,
     if (!clear_plane(pl)) return true;
     // Its own points on that plane (not a stray return above a floor, which a ray passing over
     // the floor would otherwise never clear).
-    const VoxelStats* own = rstats(k);
-    if (!own || own->count == 0) return true;
-    const Eigen::Vector3d m((k.x + 0.5) * s + own->mean[0], (k.y + 0.5) * s + own->mean[1],
-                            (k.z + 0.5) * s + own->mean[2]);
+    if (own.count == 0) return true;
+    const Eigen::Vector3d m((k.x + 0.5) * s + own.mean[0], (k.y + 0.5) * s + own.mean[1],
+                            (k.z + 0.5) * s + own.mean[2]);
     if (std::abs(pl.normal.dot(m - mean)) > std::max(0.02, 3.0 * std::sqrt(pl.eigenvalues[0])))
       return true;
     return crosses_in_voxel(k, mean, pl.normal);
@@ -205,10 +199,10 @@ InsertStats TraversabilityMap::insert_scan(const Eigen::Vector3f& o,
   // count a ray only if it crosses the plane in the voxel: rays down a corridor pass within the
   // points' spread in front of its walls without meeting them.
   auto ray_meets_points = [&](const VoxelKey& k, const VoxelStats& vs) {
-    if (vs.count < 3) return !opt_.miss_needs_crossing || crosses_pooled_plane(k);
+    if (vs.count < 3) return !opt_.miss_needs_crossing || crosses_pooled_plane(k, vs);
     const Eigen::Vector3d mean((k.x + 0.5) * s + vs.mean[0], (k.y + 0.5) * s + vs.mean[1],
                                (k.z + 0.5) * s + vs.mean[2]);
-    const Eigen::Vector3d rel = mean - o.cast<double>();
+    const Eigen::Vector3d rel = mean - od;
     const Eigen::Vector3d delta = rel - ray_dir * rel.dot(ray_dir);  // mean -> nearest ray point
     const double n = vs.count, reg = 0.0025 * s * s;  // (5% of a voxel)^2 regulariser
     Eigen::Matrix3d cov;

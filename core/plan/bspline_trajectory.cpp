@@ -176,7 +176,7 @@ void BsplineTrajectory::retime(const RobotModel& robot, int samples_per_knot, do
   w_sd_.clear();
   if (empty()) return;
   margin = std::clamp(margin, 0.1, 1.0);
-  yaw_margin = yaw_margin > 0 ? std::clamp(yaw_margin, 0.1, 1.0) : margin;
+  yaw_margin = std::clamp(yaw_margin, 0.1, 1.0);
   const double vmax = margin * std::max(robot.max_speed_mps, 1e-3);
   const double wmax = yaw_margin * std::max(robot.max_yaw_rate_rps, 1e-3);
   const double amax = margin * std::max(robot.max_accel_mps2, 1e-3);

@@ -72,9 +72,9 @@ class BsplineTrajectory {
   // yaw-acceleration limits, on samples_per_knot samples per knot interval), at rest at both
   // ends and wherever the curve stops (a pinned vertex). Limits are used at `margin` of their
   // value (the profile is exact at the samples only).
-  // yaw_margin: the same for the yaw-rate and yaw-acceleration limits (default: margin).
+  // yaw_margin: the same for the yaw-rate and yaw-acceleration limits.
   void retime(const RobotModel& robot, int samples_per_knot = 16, double margin = 0.97,
-              double yaw_margin = -1.0);
+              double yaw_margin = 0.97);
   bool retimed() const { return !w_t_.empty(); }
 
  private:
