@@ -819,6 +819,22 @@ bool LocalPlanner::on_climbed_flight(const Eigen::Vector3f& p) const {
   return false;
 }
 
+bool LocalPlanner::on_deferred_flight(const Eigen::Vector3f& p) const {
+  if (!deferred_climb_) return false;
+  const DeferredClimb& d = *deferred_climb_;
+  const Eigen::Vector3f a = d.foot_m.cast<float>(), b = d.end_m.cast<float>();
+  const float step = float(robot_.step_height_m);
+  const Eigen::Vector2f ab = (b - a).head<2>();
+  const float len = ab.norm();
+  if (len < 0.3f || p.z() < a.z() + 0.5f * step) return false;
+  const Eigen::Vector2f dir = ab / len, ap = (p - a).head<2>();
+  // A partial climb ended at the last tread seen: the flight goes on, no steeper than 45 deg (3 m
+  // more covers a storey's flight); a whole one ended on its landing.
+  const float s = ap.dot(dir), off = std::abs(ap.x() * dir.y() - ap.y() * dir.x());
+  if (s < 0.f || s > len + (d.partial ? 3.f : 0.f) || off > 0.8f) return false;
+  return p.z() <= b.z() + std::max(s - len, 0.f) + step;
+}
+
 int LocalPlanner::other_targets(const LocalPlanInput& in, int32_t except_id) const {
   const graph::ReachableGraph& g = *in.graph;
   int n_other = 0;
@@ -917,7 +933,8 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   auto defer_climb = [&]() {
     --climbs_;
     deferred_climb_ = DeferredClimb{in.robot_foot_m, in.robot_yaw_rad,
-                                    flight_target ? std::optional(flight_foot_) : std::nullopt, 0};
+                                    flight_target ? std::optional(flight_foot_) : std::nullopt,
+                                    out.target_m, climb_partial_};
     out.trajectory = BsplineTrajectory{};
     out.path_m.clear();
     out.target_m = Eigen::Vector3d::Zero();
@@ -931,6 +948,12 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     ++climbs_;
     return true;
   };
+  // A floor away from the climb left for last (walked up a flight, not climbed blind): its floor
+  // was left; the frontiers over that flight no longer wait for it.
+  if (deferred_climb_ &&
+      std::abs(in.robot_foot_m.z() - deferred_climb_->foot_m.z()) > plan_opt_.floor_change_dz_m) {
+    deferred_climb_.reset();
+  }
   out.set_aside_expired = expire_set_aside(in);
   const bool stale = floor_stale(in);
 
@@ -1072,6 +1095,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   if (climbing_) {  // a climb ended (done, overdue, or dropped on a predicted collision)
     climbing_ = false;
     climb_deferrals_ = 0;
+    deferred_climb_.reset();  // the floor is left (its frontiers over a flight no longer wait)
     climb_done_s_ = in.t_s;
     Eigen::Vector3f end = current_.pose(current_.t_end()).foot_m.cast<float>();
     bool partial = climb_partial_;

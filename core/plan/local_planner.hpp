@@ -193,7 +193,7 @@ class LocalPlanner {
   const SetAsideEntry* set_aside_at(const Eigen::Vector3f& p) const;
   // A frontier node the planner no longer targets: set aside, or on a flight climbed blind.
   bool ignored(const Eigen::Vector3f& p) const {
-    return set_aside_at(p) != nullptr || on_climbed_flight(p);
+    return set_aside_at(p) != nullptr || on_climbed_flight(p) || on_deferred_flight(p);
   }
   void set_stage_probe(StageProbe* probe) { probe_ = probe; }
 
@@ -206,6 +206,10 @@ class LocalPlanner {
   // Over a flight climbed blind (within 0.8 m of the climb's path below the landing), no
   // higher than its landing.
   bool on_climbed_flight(const Eigen::Vector3f& p) const;
+  // Over the flight of the climb left for last (within 0.8 m of its axis, from half a step over
+  // its foot to a step over its end, or over the flight's slope past a partial climb's end):
+  // what the climb will see.
+  bool on_deferred_flight(const Eigen::Vector3f& p) const;
   // Still on a flight climbed blind: its landing more than a step above (a climb dropped
   // mid-flight, its treads below never seen from above).
   bool below_climbed_landing(const Eigen::Vector3d& foot) const;
@@ -331,6 +335,8 @@ class LocalPlanner {
     Eigen::Vector3d foot_m;
     double yaw_rad;
     std::optional<FlightFoot> flight;  // found by to_flight_foot: climbed from its foot
+    Eigen::Vector3d end_m;             // where the climb found then ended
+    bool partial;                      // ... at the last tread seen (climb_partial_)
     int failures = 0;                  // cycles in which no way back to it was found
     int misses = 0;                    // climbs tried near it that found no flight (flight_foot)
   };
