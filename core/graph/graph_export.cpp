@@ -37,10 +37,11 @@ std::string to_json(const ReachableGraph& g, const std::vector<FrontierCluster>*
     appendf(s,
             "%s\n {\"id\": %u, \"xyz\": [%.3f, %.3f, %.3f], \"state\": \"%s\", \"c_sur\": %s, "
             "\"c_exp\": %s, \"boundary\": %s, \"rho\": %.3f, \"open\": %d, \"floor\": %d, "
-            "\"cluster\": %d}",
+            "\"cluster\": %d, \"flight_lead\": %s}",
             first ? "" : ",", i, n.p_m.x(), n.p_m.y(), n.p_m.z(), state_name(n.state),
             n.c_sur ? "true" : "false", n.c_exp ? "true" : "false", n.boundary ? "true" : "false",
-            n.rho, int(n.open_dirs), int(n.floor_hint), n.cluster);
+            n.rho, int(n.open_dirs), int(n.floor_hint), n.cluster,
+            n.flight_lead ? "true" : "false");
     first = false;
   }
   s += "\n],\n\"edges\": [";

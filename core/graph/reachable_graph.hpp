@@ -60,10 +60,14 @@ struct GraphNode {
   // Topological frontier flags (Sec. III-C), written by TopologicalFrontiers.
   bool c_sur = false, c_exp = false;  // criteria C_sur (Eq. 5) and C_exp
   bool boundary = false;              // ablation: near the geometric boundary of C_reach
-  float rho = 0;                      // rho_i, Eq. 5
-  uint8_t open_dirs = 0;              // |Theta_i^open|
-  int16_t floor_hint = 0;             // round(z / floor_height_hint_m)
-  int32_t cluster = -1;               // frontier cluster id, -1 if none
+  // Not a frontier: a C_exp probe climbed a flight onto treads out of C_reach (climb_frontiers).
+  // The graph cannot follow a flight whose treads' backs, shadowed by the next riser, are unseen;
+  // a blind climb from its foot can (LocalPlanner, once a floor has no other target).
+  bool flight_lead = false;
+  float rho = 0;           // rho_i, Eq. 5
+  uint8_t open_dirs = 0;   // |Theta_i^open|
+  int16_t floor_hint = 0;  // round(z / floor_height_hint_m)
+  int32_t cluster = -1;    // frontier cluster id, -1 if none
   uint8_t degree = 0;
   uint8_t queued = 0;  // kQueued* bits
   std::array<EdgeId, kMaxDegree> edges{};

@@ -247,9 +247,10 @@ constexpr int kStairSteps = 2;
 
 bool SupportQuery::probe_open_climbing(const Eigen::Vector3f& foot, const Eigen::Vector2f& dir,
                                        float length_m, float height_m, float min_free_m,
-                                       float min_unknown_m, bool* climbed) {
+                                       float min_unknown_m, bool* climbed, bool* leaves_reach) {
   constexpr int kMaxClimbs = 24;
   if (climbed) *climbed = false;
+  if (leaves_reach) *leaves_reach = false;
   // Horizontal probe: |dx| + |dy| voxels per metre (6-connected walk).
   const float per_m = (std::abs(dir.x()) + std::abs(dir.y())) * inv_vs_;
   const int need_free = int(std::ceil(min_free_m * per_m));
@@ -283,6 +284,7 @@ bool SupportQuery::probe_open_climbing(const Eigen::Vector3f& foot, const Eigen:
           climbed)
         *climbed = true;
       if (top->state == TravState::kUnobserved) return free_total >= need_free;
+      if (leaves_reach && stair_steps >= kStairSteps && !top->reachable) *leaves_reach = true;
       zc = top->p_m.z();
       s_climb = s_hit;
       s0 = std::max(s_hit, s0 + 0.5f * vs_);

@@ -100,9 +100,10 @@ class SupportQuery {
   // close every probe at body height up the flight and the stairs never become a frontier (paper
   // III-C: stairs are the way to the next floor). `climbed` (optional) tells whether an open
   // probe had climbed two stair steps (each steeper than 25 deg) first: it runs up a flight.
+  // *leaves_reach: the probe climbed a flight (two stair steps) onto support out of C_reach.
   bool probe_open_climbing(const Eigen::Vector3f& foot, const Eigen::Vector2f& dir, float length_m,
                            float height_m, float min_free_m, float min_unknown_m,
-                           bool* climbed = nullptr);
+                           bool* climbed = nullptr, bool* leaves_reach = nullptr);
 
   const map::MapView& view() const { return view_; }
   float voxel_size() const { return vs_; }

@@ -57,13 +57,14 @@ float TopologicalFrontiers::missing_surface_ratio(SupportQuery& q, const GraphNo
 // probe_unknown_m of it) without hitting an obstacle first. *up counts the open probes that
 // climbed first.
 int TopologicalFrontiers::open_directions(SupportQuery& q, const ReachableGraph& g, NodeId i,
-                                          int* up) {
+                                          int* up, int* leads) {
   const GraphNode& n = g.node(i);
   const int probes = std::max(1, opt_.probes);
   const float half = float(opt_.alpha_min_rad) * 0.5f;
   const float min_free = 2.0f * q.voxel_size();
   int open = 0;
   *up = 0;
+  if (leads) *leads = 0;
   for (int k = 0; k < probes; ++k) {
     const float th = 2.0f * float(M_PI) * float(k) / float(probes);
     bool covered = false;
@@ -74,12 +75,14 @@ int TopologicalFrontiers::open_directions(SupportQuery& q, const ReachableGraph&
       covered = std::abs(diff) < half;
     }
     if (covered) continue;
-    bool climbed = false;
+    bool climbed = false, out_of_reach = false;
     const bool o = q.probe_open_climbing(n.p_m, Eigen::Vector2f(std::cos(th), std::sin(th)),
                                          float(opt_.probe_length_m), float(opt_.probe_height_m),
-                                         min_free, float(opt_.probe_unknown_m), &climbed);
+                                         min_free, float(opt_.probe_unknown_m), &climbed,
+                                         leads ? &out_of_reach : nullptr);
     open += o;
     *up += o && climbed;
+    if (leads) *leads += out_of_reach;
   }
   return open;
 }
@@ -128,7 +131,7 @@ void TopologicalFrontiers::evaluate(ReachableGraph& g, SupportQuery& q, NodeId i
 
 void TopologicalFrontiers::evaluate_flags(ReachableGraph& g, SupportQuery& q, NodeId i) {
   GraphNode& n = g.mutable_node(i);
-  n.c_sur = n.c_exp = n.boundary = false;
+  n.c_sur = n.c_exp = n.boundary = n.flight_lead = false;
   if (opt_.boundary_frontiers) {
     n.boundary = near_reach_boundary(q, n);
     return;
@@ -139,9 +142,10 @@ void TopologicalFrontiers::evaluate_flags(ReachableGraph& g, SupportQuery& q, No
     n.c_sur = omega * 4 >= std::max(1, opt_.surface_samples) && n.rho >= float(opt_.rho_min);
   }
   if (opt_.use_c_exp) {
-    int up = 0;
-    const int open = open_directions(q, g, i, &up);
+    int up = 0, leads = 0;
+    const int open = open_directions(q, g, i, &up, opt_.climb_frontiers ? &leads : nullptr);
     n.open_dirs = uint8_t(std::min(open, 255));
+    n.flight_lead = leads > 0;
     // A flight of stairs is one probe wide: its walls close the probes beside it.
     // One probe that climbs it into unknown space is the way to the next floor (Sec. III-C).
     n.c_exp = open >= opt_.theta_min || (opt_.climb_frontiers && up >= 1);

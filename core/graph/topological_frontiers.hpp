@@ -53,7 +53,8 @@ class TopologicalFrontiers {
 
  private:
   float missing_surface_ratio(SupportQuery& q, const GraphNode& n, int* samples);  // Eq. 5
-  int open_directions(SupportQuery& q, const ReachableGraph& g, NodeId i, int* up);
+  int open_directions(SupportQuery& q, const ReachableGraph& g, NodeId i, int* up,
+                      int* leads = nullptr);
   bool near_reach_boundary(SupportQuery& q, const GraphNode& n);
   void evaluate(ReachableGraph& g, SupportQuery& q, NodeId i);
   void evaluate_flags(ReachableGraph& g, SupportQuery& q, NodeId i);

@@ -532,6 +532,37 @@ bool LocalPlanner::to_flight_foot(const LocalPlanInput& in, const graph::Frontie
   return true;
 }
 
+bool LocalPlanner::to_flight_lead(const LocalPlanInput& in, LocalPlanResult& out) {
+  if (!plan_opt_.climb_blind || !plan_opt_.flight_foot) return false;
+  const graph::ReachableGraph& g = *in.graph;
+  const Eigen::Vector3f robot = in.robot_foot_m.cast<float>();
+  std::vector<std::pair<float, graph::NodeId>> leads;
+  for (graph::NodeId i = 0; i < g.node_capacity(); ++i) {
+    const graph::GraphNode& n = g.node(i);
+    if (!n.alive || !n.flight_lead ||
+        std::abs(n.p_m.z() - robot.z()) >= float(plan_opt_.floor_node_band_m) || ignored(n.p_m))
+      continue;
+    // Each lead is looked at once (flight_foot scans the map around it): most are no flight
+    // (teaching_building seed 1: 23 leads, one at its stairs).
+    const bool tried =
+        std::any_of(leads_tried_.begin(), leads_tried_.end(),
+                    [&](const Eigen::Vector3f& q) { return (q - n.p_m).norm() < 0.3f; });
+    if (!tried) leads.emplace_back((n.p_m - robot).head<2>().norm(), i);
+  }
+  std::sort(leads.begin(), leads.end());
+  for (const auto& [d, i] : leads) {
+    leads_tried_.push_back(g.node(i).p_m);
+    graph::FrontierCluster c;
+    c.nodes = {i};
+    c.centroid_m = g.node(i).p_m;
+    if (to_flight_foot(in, c, out)) {
+      out.replan_reason = "to a flight's foot: the floor is done, the flight rises out of reach";
+      return true;
+    }
+  }
+  return false;
+}
+
 bool LocalPlanner::straight_walk(const LocalPlanInput& in, const std::vector<Eigen::Vector3d>& pts,
                                  double yaw, LocalPlanResult& out) {
   auto w = plan::straight_walk(checker_, *in.view, robot_, pts, yaw, in.t_s);
@@ -1179,6 +1210,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   if (in.clusters->empty()) {
     if (try_climb(true)) return commit_climb("climb on: no frontier, standing on a flight");
     if (climb_last()) return to_climb("climb on: no frontier, up the flight left for last");
+    if (to_flight_lead(in, out)) return out;
     out.status = LocalPlanStatus::kNoFrontiers;
     return out;
   }
@@ -1252,6 +1284,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     if (climb_last())
       return to_climb("climb on: no reachable frontier, up the flight left for last");
     if (retry_from_elsewhere(in, out)) return out;
+    if (to_flight_lead(in, out)) return out;
     out.status = LocalPlanStatus::kNoReachableTarget;
     return out;
   }
@@ -1431,6 +1464,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
                        [&](graph::NodeId n) { return !ignored(g.node(n).p_m); });
   });
   if (!left && retry_from_elsewhere(in, out)) return out;
+  if (!left && to_flight_lead(in, out)) return out;
   out.status = LocalPlanStatus::kNoReachableTarget;
   return out;
 }

@@ -271,6 +271,9 @@ class LocalPlanner {
                 const FlightFoot* given = nullptr);
   // PlanOptions::flight_foot: cluster c, about to be set aside, has a flight's first riser near:
   // a new target at the flight's foot (flight_foot()), once per foot; false if none.
+  // The floor has no other target: to the foot of a flight that rises out of C_reach (a node's
+  // GraphNode::flight_lead on this floor, its foot not tried yet); false if none.
+  bool to_flight_lead(const LocalPlanInput& in, LocalPlanResult& out);
   bool to_flight_foot(const LocalPlanInput& in, const graph::FrontierCluster& c,
                       LocalPlanResult& out);
   // Stage 3 to f's stand point, else up to 0.75 m farther back on the axis (room to turn).
@@ -341,8 +344,9 @@ class LocalPlanner {
     int misses = 0;                    // climbs tried near it that found no flight (flight_foot)
   };
   std::optional<DeferredClimb> deferred_climb_;
-  int climb_deferrals_ = 0;  // climbs deferred since the last climb
-  int descents_ = 0;         // descend_flight walks since the last target
+  std::vector<Eigen::Vector3f> leads_tried_;  // flight leads looked at by to_flight_lead
+  int climb_deferrals_ = 0;                   // climbs deferred since the last climb
+  int descents_ = 0;                          // descend_flight walks since the last target
   bool climb_start_ = false;
   bool climbing_ = false;     // the committed move is a climb
   double climb_done_s_ = -1;  // when the last climb ended

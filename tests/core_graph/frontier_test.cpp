@@ -376,8 +376,8 @@ TEST(TopologicalFrontiers, ProbeThroughAHoleInAWallIsClosed) {
 // seed 2's gallery strips, session 18). On, the nodes at the edge of the seen part are.
 TEST(TopologicalFrontiers, ASlabSeenFromBelowIsNoSurfaceForTheFloorAbove) {
   World w;
-  w.add({0, -2, -0.3f}, {10, 2, 0.0f});  // ground floor
-  w.add({0, -2, 2.8f}, {10, 2, 3.0f});   // the upper floor's slab
+  w.add({0, -2, -0.3f}, {10, 2, 0.0f});          // ground floor
+  w.add({0, -2, 2.8f}, {10, 2, 3.0f});           // the upper floor's slab
   w.add({-0.2f, -2.2f, -0.3f}, {10.2f, -2, 6});  // walls around both floors
   w.add({-0.2f, 2, -0.3f}, {10.2f, 2.2f, 6});
   w.add({-0.2f, -2, -0.3f}, {0, 2, 6});
@@ -406,5 +406,51 @@ TEST(TopologicalFrontiers, ASlabSeenFromBelowIsNoSurfaceForTheFloorAbove) {
     } else {
       EXPECT_EQ(c_sur, 0) << "rho max " << rho_max;
     }
+  }
+}
+
+// GraphOptions::climb_frontiers: a walled flight ending at a landing with a wall ahead (the first
+// flight of a U-shaped stair), seen from the floor. The back of each tread near the sensor's
+// height is shadowed by the next riser: the treads are support, but C_reach does not join them
+// to the floor. The graph cannot follow the flight; the nodes near its foot are flight leads
+// (GraphNode::flight_lead), where the planner goes once the floor has no other target
+// (teaching_building seed 1, session 23: seen from the side, the flight's foot frontier was cleared
+// and the stairs never climbed).
+TEST(TopologicalFrontiers, AFlightRisingOutOfTheReachableSetIsAFlightLead) {
+  World w;
+  w.add({-3.2f, -2, -0.3f}, {6, 2, 0.0f});
+  w.stairs(0.0f, -0.6f, 0.6f, 0.0f, 7, 0.17f, 0.29f);  // up to 1.19 m at x = 2.03
+  w.add({2.03f, -0.6f, -0.3f}, {3.4f, 0.6f, 1.19f});   // the landing
+  w.add({3.4f, -0.72f, 0}, {3.6f, 0.72f, 3.5f});       // its wall
+  w.add({0, -0.72f, 0}, {3.4f, -0.6f, 3.5f});          // side walls
+  w.add({0, 0.6f, 0}, {3.4f, 0.72f, 3.5f});
+  w.add({-3.2f, -2, 0}, {-3.0f, 2, 2.5f});  // a wall behind the robot
+  for (const bool on : {true, false}) {
+    SCOPED_TRACE(on ? "climb_frontiers on" : "off");
+    GraphOptions o;
+    o.climb_frontiers = on;
+    Harness h(o);
+    for (const float x : {-2.5f, -1.5f, -0.8f})
+      h.observe(w, Vector3f(x, 0.1f, 0.62f), Vector3f(x, 0.1f, 0), 150000, 7, 8.0f);
+    // The premise: a tread near the top is support the map holds, out of C_reach.
+    const auto top = h.map.view().support_surface_near(Vector3f(1.75f, 0.05f, 1.19f), 0.1);
+    ASSERT_TRUE(top.has_value());
+    EXPECT_FALSE(top->reachable);
+    SupportQuery q(h.map.view(), o);
+    bool climbed = false, leaves = false;
+    q.probe_open_climbing(Vector3f(-0.3f, 0, 0), Eigen::Vector2f(1, 0), 3.0f, 0.3f, 0.2f, 0.3f,
+                          &climbed, &leaves);
+    EXPECT_TRUE(climbed);
+    EXPECT_TRUE(leaves);
+    // Flight leads: with the option, nodes within a probe's length of the flight's foot.
+    int leads = 0, far = 0;
+    for (NodeId i = 0; i < h.graph.node_capacity(); ++i) {
+      const auto& n = h.graph.node(i);
+      if (!n.alive || !n.flight_lead) continue;
+      ++leads;
+      far += n.p_m.head<2>().norm() > 3.2f;
+    }
+    EXPECT_EQ(leads > 0, on) << leads;
+    EXPECT_EQ(far, 0);
   }
 }

@@ -1000,3 +1000,65 @@ TEST(LocalPlanner, AFrontierOverTheFlightLeftForLastIsNoTargetMeanwhile) {
   EXPECT_TRUE(run.flight_ignored);
   EXPECT_FALSE(run.floor_ignored);
 }
+
+// GraphNode::flight_lead: the first flight of a U-shaped stair (walled, a landing with a wall
+// ahead) seen from the floor is in the map but out of C_reach, and no frontier is left on the
+// floor. With flight_foot the robot goes to the flight's foot and climbs; without it the floor
+// ends "no frontiers" (teaching_building seed 1, session 23: the flight's foot frontier was
+// cleared from the side, the run ended "complete" with the upper floor unexplored).
+namespace {
+World walled_flight_room() {
+  World w;
+  w.add({-4, -3, -0.2f}, {6, 3, 0});
+  w.stairs(0.0f, -0.6f, 0.6f, 0.0f, 7, 0.17f, 0.29f);  // up to 1.19 m at x = 2.03
+  w.add({2.03f, -0.6f, -0.2f}, {3.4f, 0.6f, 1.19f});   // the landing
+  w.add({3.4f, -0.72f, 0}, {3.6f, 0.72f, 3.5f});       // its wall
+  w.add({0, -0.72f, 0}, {3.4f, -0.6f, 3.5f});          // the stairwell's sides
+  w.add({0, 0.6f, 0}, {3.4f, 0.72f, 3.5f});
+  w.add({-4, -3.2f, 0}, {6, -3, 3.5f});  // the room's walls
+  w.add({-4, 3, 0}, {6, 3.2f, 3.5f});
+  w.add({-4.2f, -3, 0}, {-4, 3, 3.5f});
+  return w;
+}
+}  // namespace
+
+TEST(LocalPlanner, WithNoFrontierLeftTheRobotClimbsAFlightThatRisesOutOfReach) {
+  storey::core::graph::GraphOptions go;
+  go.climb_frontiers = true;
+  Harness h(go);
+  const World w = walled_flight_room();
+  for (const Eigen::Vector3f f : {Eigen::Vector3f(-2.5f, 0.1f, 0), Eigen::Vector3f(-1.5f, -1.2f, 0),
+                                  Eigen::Vector3f(-0.8f, 1.0f, 0)})
+    h.observe(w, f, 60000, 3);
+  int leads = 0;
+  for (storey::core::graph::NodeId i = 0; i < h.graph.node_capacity(); ++i)
+    leads += h.graph.node(i).alive && h.graph.node(i).flight_lead;
+  ASSERT_GT(leads, 0);
+  const std::vector<storey::core::graph::FrontierCluster> none;
+  for (const bool on : {true, false}) {
+    SCOPED_TRACE(on ? "flight_foot on" : "off");
+    PlanOptions po;
+    po.climb_blind = true;
+    po.flight_foot = on;
+    const auto view = h.map.view();
+    LocalPlanner lp(RobotModel{}, po, 0.1);
+    Eigen::Vector3f foot(-2.5f, 0.1f, 0);
+    double yaw = 0, t = 0;
+    bool to_foot = false, climbed = false;
+    for (int cycle = 0; cycle < 6 && !climbed; ++cycle) {
+      const auto r = walked_cycle(lp, h, view, none, foot, yaw, t);
+      if (!r) continue;
+      const std::string reason = r->replan_reason;
+      to_foot |= reason.rfind("to a flight's foot: the floor is done", 0) == 0;
+      climbed = reason.rfind("climb on", 0) == 0 && foot.z() > 0.5f;
+    }
+    EXPECT_EQ(to_foot, on);
+    EXPECT_EQ(climbed, on);
+    if (!on) {
+      LocalPlanInput in = input(h, view, foot, t);
+      in.clusters = &none;
+      in.last_resort = true;
+      EXPECT_EQ(lp.plan(in).status, LocalPlanStatus::kNoFrontiers);
+    }
+  }
+}

@@ -26,15 +26,15 @@ void expect_both_floors_safely(const SimRunResult& r) {
 TEST(ExploreStair, AClimbStoppedOnTheFlightGoesOnUpAndTheRunEndsComplete) {
   const SimRunResult r = run_exploration(quiet_run("test_stair", 1, 300));
   const RunMetrics& m = r.metrics;
-  // Measured (seed 1, session 22): complete at 122.5 s, floors 0.870 / 0.852 (session 18: 135.0 s,
-  // 0.884 / 0.847; with session 22's braking fix and not yet the no-retry-after-a-climb rule, the
-  // robot climbed, walked back down toward old path failures and ended with 0.295 upstairs). With
-  // flight_foot, near a climb deferred beside the flight but facing away, it walks to the
-  // deferral's pose again (session 17 dropped it there and ended at 86.5 s with the upper floor at
-  // 0.0). Session 12 (before flight_foot): 85.5 s, 0.858 / 0.811. Before that: the climb ended
-  // mid-flight (z ~ 1.5 m), no graph node grew there and the run ended complete at 71.0 s with the
-  // upper floor at 0.058; with that fixed but the completion check counting the climbed flight's
-  // frontiers, it ran to the 300 s limit.
+  // Measured (seed 1, session 23): complete at 86.5 s, floors 0.870 / 0.835 (session 22: 122.5 s,
+  // 0.870 / 0.852; session 18: 135.0 s, 0.884 / 0.847; with session 22's braking fix and not yet
+  // the no-retry-after-a-climb rule, the robot climbed, walked back down toward old path failures
+  // and ended with 0.295 upstairs). With flight_foot, near a climb deferred beside the flight but
+  // facing away, it walks to the deferral's pose again (session 17 dropped it there and ended
+  // at 86.5 s with the upper floor at 0.0). Session 12 (before flight_foot): 85.5 s, 0.858 / 0.811.
+  // Before that: the climb ended mid-flight (z ~ 1.5 m), no graph node grew there and the run ended
+  // complete at 71.0 s with the upper floor at 0.058; with that fixed but the completion check
+  // counting the climbed flight's frontiers, it ran to the 300 s limit.
   expect_both_floors_safely(r);
   EXPECT_LT(m.exploration_time_s, 260.0);
 }
@@ -46,8 +46,9 @@ TEST(ExploreStair, AClimbStoppedOnTheFlightGoesOnUpAndTheRunEndsComplete) {
 // "complete" with the upper floor at 18.4 % (session 16). Now that ground is entered only where
 // the robot walks level or a climb has ended on its landing (firmware/blind_support.hpp).
 TEST(ExploreStair, TheNarrowLandingIsEnteredAtItsOwnHeight) {
-  // Measured (seed 2, session 22): complete at 145.0 s, floors 0.874 / 0.856 (session 18: 142.0 s,
-  // 0.892 / 0.872; session 17, flight_foot alone: 148.0 s, 0.893 / 0.847).
+  // Measured (seed 2, session 23): complete at 103.5 s, floors 0.865 / 0.848 (session 22: 145.0 s,
+  // 0.874 / 0.856; session 18: 142.0 s, 0.892 / 0.872; session 17, flight_foot alone: 148.0 s,
+  // 0.893 / 0.847).
   expect_both_floors_safely(run_exploration(quiet_run("test_stair", 2, 300)));
 }
 
