@@ -536,6 +536,22 @@ bool LocalPlanner::to_flight_lead(const LocalPlanInput& in, LocalPlanResult& out
   if (!plan_opt_.climb_blind || !plan_opt_.flight_foot) return false;
   const graph::ReachableGraph& g = *in.graph;
   const Eigen::Vector3f robot = in.robot_foot_m.cast<float>();
+  // A trip to a lead's foot cut short (frontiers came back on the way, teaching_building seed 1:
+  // the foot was never reached and, tried once, never again): taken up again, a few times.
+  if (lead_trip_ && (lead_trip_->foot.foot_m - in.robot_foot_m).head<2>().norm() > 0.5 &&
+      lead_trip_->trips < kMaxLeadTrips) {
+    ++lead_trip_->trips;
+    flight_foot_ = lead_trip_->foot;
+    if (free_start(in) && to_foot_of(in, flight_foot_, out)) {
+      graph::FrontierCluster c;
+      c.centroid_m = flight_foot_.foot_m.cast<float>();
+      adopt_target(in, c, out);
+      flight_target_ = true;
+      out.replan_reason = "to a flight's foot: the floor is done, the flight rises out of reach";
+      return true;
+    }
+  }
+  lead_trip_.reset();
   std::vector<std::pair<float, graph::NodeId>> leads;
   for (graph::NodeId i = 0; i < g.node_capacity(); ++i) {
     const graph::GraphNode& n = g.node(i);
@@ -556,6 +572,7 @@ bool LocalPlanner::to_flight_lead(const LocalPlanInput& in, LocalPlanResult& out
     c.nodes = {i};
     c.centroid_m = g.node(i).p_m;
     if (to_flight_foot(in, c, out)) {
+      lead_trip_ = LeadTrip{flight_foot_, 1};
       out.replan_reason = "to a flight's foot: the floor is done, the flight rises out of reach";
       return true;
     }
@@ -1127,6 +1144,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     climbing_ = false;
     climb_deferrals_ = 0;
     deferred_climb_.reset();  // the floor is left (its frontiers over a flight no longer wait)
+    lead_trip_.reset();
     climb_done_s_ = in.t_s;
     Eigen::Vector3f end = current_.pose(current_.t_end()).foot_m.cast<float>();
     bool partial = climb_partial_;

@@ -345,8 +345,14 @@ class LocalPlanner {
   };
   std::optional<DeferredClimb> deferred_climb_;
   std::vector<Eigen::Vector3f> leads_tried_;  // flight leads looked at by to_flight_lead
-  int climb_deferrals_ = 0;                   // climbs deferred since the last climb
-  int descents_ = 0;                          // descend_flight walks since the last target
+  struct LeadTrip {
+    FlightFoot foot;
+    int trips = 0;
+  };
+  static constexpr int kMaxLeadTrips = 3;
+  std::optional<LeadTrip> lead_trip_;  // to_flight_lead's last trip, until its foot is reached
+  int climb_deferrals_ = 0;            // climbs deferred since the last climb
+  int descents_ = 0;                   // descend_flight walks since the last target
   bool climb_start_ = false;
   bool climbing_ = false;     // the committed move is a climb
   double climb_done_s_ = -1;  // when the last climb ended

@@ -1020,16 +1020,21 @@ World walled_flight_room() {
   w.add({-4.2f, -3, 0}, {-4, 3, 3.5f});
   return w;
 }
+
+// walled_flight_room() seen from three places on the floor, with flight leads.
+void observe_walled_flight_room(Harness& h) {
+  const World w = walled_flight_room();
+  for (const Eigen::Vector3f f : {Eigen::Vector3f(-2.5f, 0.1f, 0), Eigen::Vector3f(-1.5f, -1.2f, 0),
+                                  Eigen::Vector3f(-0.8f, 1.0f, 0)})
+    h.observe(w, f, 60000, 3);
+}
 }  // namespace
 
 TEST(LocalPlanner, WithNoFrontierLeftTheRobotClimbsAFlightThatRisesOutOfReach) {
   storey::core::graph::GraphOptions go;
   go.climb_frontiers = true;
   Harness h(go);
-  const World w = walled_flight_room();
-  for (const Eigen::Vector3f f : {Eigen::Vector3f(-2.5f, 0.1f, 0), Eigen::Vector3f(-1.5f, -1.2f, 0),
-                                  Eigen::Vector3f(-0.8f, 1.0f, 0)})
-    h.observe(w, f, 60000, 3);
+  observe_walled_flight_room(h);
   int leads = 0;
   for (storey::core::graph::NodeId i = 0; i < h.graph.node_capacity(); ++i)
     leads += h.graph.node(i).alive && h.graph.node(i).flight_lead;
@@ -1061,4 +1066,37 @@ TEST(LocalPlanner, WithNoFrontierLeftTheRobotClimbsAFlightThatRisesOutOfReach) {
       EXPECT_EQ(lp.plan(in).status, LocalPlanStatus::kNoFrontiers);
     }
   }
+}
+
+// A trip to a lead's flight cut short (here overdue, the robot never moved; teaching_building
+// seed 1, session 23: frontiers came back on the way and the foot, tried once, was never tried
+// again) is taken up again once the floor has no target, a bounded number of times.
+TEST(LocalPlanner, ATripToAFlightLeadCutShortIsTakenUpAgain) {
+  storey::core::graph::GraphOptions go;
+  go.climb_frontiers = true;
+  Harness h(go);
+  observe_walled_flight_room(h);
+  PlanOptions po;
+  po.climb_blind = true;
+  po.flight_foot = true;
+  const auto view = h.map.view();
+  LocalPlanner lp(RobotModel{}, po, 0.1);
+  const std::vector<storey::core::graph::FrontierCluster> none;
+  const Eigen::Vector3f foot(-2.5f, 0.1f, 0);
+  double t = 0;
+  int trips = 0;
+  for (int cycle = 0; cycle < 8; ++cycle) {
+    LocalPlanInput in = input(h, view, foot, t);
+    in.clusters = &none;
+    in.last_resort = true;
+    const LocalPlanResult r = lp.plan(in);
+    if (r.status == LocalPlanStatus::kNewTrajectory) {
+      EXPECT_EQ(std::string(r.replan_reason).rfind("to a flight's foot", 0), 0u) << r.replan_reason;
+      ++trips;
+      t = r.trajectory.t_end() + 4.0;  // overdue: the robot did not move
+    } else {
+      t += 1.0;
+    }
+  }
+  EXPECT_EQ(trips, 3);  // the first trip and two more (kMaxLeadTrips)
 }
