@@ -534,6 +534,8 @@ bool LocalPlanner::to_flight_foot(const LocalPlanInput& in, const graph::Frontie
 
 bool LocalPlanner::to_flight_lead(const LocalPlanInput& in, LocalPlanResult& out) {
   if (!plan_opt_.climb_blind || !plan_opt_.flight_foot) return false;
+  static constexpr const char* kReason =
+      "to a flight's foot: the floor is done, the flight rises out of reach";
   const graph::ReachableGraph& g = *in.graph;
   const Eigen::Vector3f robot = in.robot_foot_m.cast<float>();
   // A trip to a lead's foot cut short (frontiers came back on the way, teaching_building seed 1:
@@ -547,7 +549,7 @@ bool LocalPlanner::to_flight_lead(const LocalPlanInput& in, LocalPlanResult& out
       c.centroid_m = flight_foot_.foot_m.cast<float>();
       adopt_target(in, c, out);
       flight_target_ = true;
-      out.replan_reason = "to a flight's foot: the floor is done, the flight rises out of reach";
+      out.replan_reason = kReason;
       return true;
     }
   }
@@ -573,7 +575,7 @@ bool LocalPlanner::to_flight_lead(const LocalPlanInput& in, LocalPlanResult& out
     c.centroid_m = g.node(i).p_m;
     if (to_flight_foot(in, c, out)) {
       lead_trip_ = LeadTrip{flight_foot_, 1};
-      out.replan_reason = "to a flight's foot: the floor is done, the flight rises out of reach";
+      out.replan_reason = kReason;
       return true;
     }
   }
