@@ -349,6 +349,30 @@ void LocalPlanner::build_search_graph(const graph::ReachableGraph& g) {
     edges_scratch_.push_back({ge.a, ge.b, double(std::max(ge.cost, ge.length_m))});
   }
   sg_ = SearchGraph::from_edges(pos_scratch_, edges_scratch_, /*undirected=*/true);
+  sg_fresh_ = true;
+}
+
+graph::NodeId LocalPlanner::linked_node_near(const graph::ReachableGraph& g,
+                                             const Eigen::Vector3f& p, float r, float dz) {
+  near_scratch_.clear();
+  g.nodes_within(p, r, dz, near_scratch_);
+  graph::NodeId best_n = graph::kNoId;
+  float best = std::numeric_limits<float>::infinity();
+  for (graph::NodeId n : near_scratch_) {
+    const float d = (g.node(n).p_m - p).squaredNorm();
+    if (g.node(n).alive && g.node(n).degree > 0 && d < best) best = d, best_n = n;
+  }
+  return best_n;
+}
+
+void LocalPlanner::ensure_search_graph(const LocalPlanInput& in) {
+  if (sg_fresh_) return;
+  const graph::ReachableGraph& g = *in.graph;
+  build_search_graph(g);
+  const graph::NodeId root = g.root();
+  robot_node_ = root != graph::kNoId && g.node(root).alive && g.node(root).degree > 0
+                    ? root
+                    : linked_node_near(g, in.robot_foot_m.cast<float>(), 1.5f, 1.0f);
 }
 
 // The body box with its margin may overlap an obstacle where the robot stands (tracking error,
@@ -500,15 +524,18 @@ bool LocalPlanner::escape(const LocalPlanInput& in, LocalPlanResult& out,
 
 bool LocalPlanner::to_foot_of(const LocalPlanInput& in, const FlightFoot& f, LocalPlanResult& out) {
   const double step = robot_.step_height_m;
+  ensure_search_graph(in);
   for (double extra = 0.0; extra <= 0.75 + 1e-9; extra += 0.25) {
     const Eigen::Vector2d p = f.foot_m.head<2>() - extra * f.axis.dir;
     const auto sp = in.view->support_surface_near(
         Eigen::Vector3f(float(p.x()), float(p.y()), float(f.foot_m.z())), 0.5 * step);
     if (!sp || !sp->reachable) continue;
+    const Eigen::Vector3f q(float(p.x()), float(p.y()), sp->height_m);
+    // The nearest linked node: the walk along G_real where the voxel A* finds no path (a sparse
+    // map, or a trip across the building past its expansion limit).
+    const graph::NodeId n = linked_node_near(*in.graph, q, 0.75f, 0.3f);
     SetAsideReason why = SetAsideReason::kAstarFailed;
-    if (try_target(in, Viewpoint{{p.x(), p.y(), double(sp->height_m)}, f.yaw_rad, graph::kNoId},
-                   out, &why))
-      return true;
+    if (try_target(in, Viewpoint{q.cast<double>(), f.yaw_rad, n}, out, &why)) return true;
   }
   return false;
 }
@@ -532,10 +559,11 @@ bool LocalPlanner::to_flight_foot(const LocalPlanInput& in, const graph::Frontie
   return true;
 }
 
-bool LocalPlanner::to_flight_lead(const LocalPlanInput& in, LocalPlanResult& out) {
+bool LocalPlanner::to_flight_lead(const LocalPlanInput& in, LocalPlanResult& out, bool stale) {
   if (!plan_opt_.climb_blind || !plan_opt_.flight_foot) return false;
-  static constexpr const char* kReason =
-      "to a flight's foot: the floor is done, the flight rises out of reach";
+  const char* const reason =
+      stale ? "to a flight's foot: the floor's graph stopped growing, the flight rises out of reach"
+            : "to a flight's foot: the floor is done, the flight rises out of reach";
   const graph::ReachableGraph& g = *in.graph;
   const Eigen::Vector3f robot = in.robot_foot_m.cast<float>();
   // A trip to a lead's foot cut short (frontiers came back on the way, teaching_building seed 1:
@@ -549,7 +577,7 @@ bool LocalPlanner::to_flight_lead(const LocalPlanInput& in, LocalPlanResult& out
       c.centroid_m = flight_foot_.foot_m.cast<float>();
       adopt_target(in, c, out);
       flight_target_ = true;
-      out.replan_reason = kReason;
+      out.replan_reason = reason;
       return true;
     }
   }
@@ -575,7 +603,7 @@ bool LocalPlanner::to_flight_lead(const LocalPlanInput& in, LocalPlanResult& out
     c.centroid_m = g.node(i).p_m;
     if (to_flight_foot(in, c, out)) {
       lead_trip_ = LeadTrip{flight_foot_, 1};
-      out.replan_reason = kReason;
+      out.replan_reason = reason;
       return true;
     }
   }
@@ -921,7 +949,9 @@ bool LocalPlanner::try_target(const LocalPlanInput& in, const Viewpoint& vp, Loc
     path.points_m.clear();
     path.points_m.push_back(start_foot_m_);
     for (uint32_t u : gp.nodes) path.points_m.push_back(sg_.position(u));
-    if (path.points_m.size() == 2) path.points_m.push_back(vp.p_m);
+    // A viewpoint beside its node (a flight's foot, to_foot_of): on to it.
+    if (path.points_m.size() == 2 || (path.points_m.back() - vp.p_m).norm() > 0.05)
+      path.points_m.push_back(vp.p_m);
     path.status = VoxelAStarStatus::kOk;
     ++out.graph_fallbacks;
     return true;
@@ -958,6 +988,7 @@ bool LocalPlanner::try_target(const LocalPlanInput& in, const Viewpoint& vp, Loc
 LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   LocalPlanResult out;
   periodic_ = false;
+  sg_fresh_ = false;  // the graph may have changed since the last cycle
   if (!in.view || !in.graph || !in.clusters || !in.viewpoints || !in.robot_foot_m.allFinite()) {
     out.status = LocalPlanStatus::kBadInput;
     return out;
@@ -1227,6 +1258,10 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   // (PlanOptions::stale_floor_s); the climb left for last is taken.
   if (stale && deferred_climb_ && climb_last())
     return to_climb("climb on: the floor's graph stopped growing, up the flight left for last");
+  // ... or, with no climb left for last, a flight that rises out of reach (teaching_building
+  // seed 1, session 23: frontiers kept coming back near the stair hub, the floor was never without
+  // a target before 1800 s, and its one stair was never climbed).
+  if (stale && !deferred_climb_ && to_flight_lead(in, out, true)) return out;
   if (in.clusters->empty()) {
     if (try_climb(true)) return commit_climb("climb on: no frontier, standing on a flight");
     if (climb_last()) return to_climb("climb on: no frontier, up the flight left for last");
@@ -1234,7 +1269,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     out.status = LocalPlanStatus::kNoFrontiers;
     return out;
   }
-  build_search_graph(g);
+  if (!sg_fresh_) build_search_graph(g);
   uint32_t robot_node = g.root();
   if (robot_node == graph::kNoId || !g.node(robot_node).alive)
     robot_node = g.nearest(in.robot_foot_m.cast<float>(), 1.5f, 1.0f);
@@ -1247,13 +1282,8 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
       out.status = LocalPlanStatus::kNoRobotNode;
       return out;
     }
-    near_scratch_.clear();
-    g.nodes_within(in.robot_foot_m.cast<float>(), 1.5f, 1.0f, near_scratch_);
-    float best = std::numeric_limits<float>::infinity();
-    for (graph::NodeId n : near_scratch_) {
-      const float d = (g.node(n).p_m - in.robot_foot_m.cast<float>()).squaredNorm();
-      if (g.node(n).alive && g.node(n).degree > 0 && d < best) best = d, robot_node = n;
-    }
+    const graph::NodeId linked = linked_node_near(g, in.robot_foot_m.cast<float>(), 1.5f, 1.0f);
+    if (linked != graph::kNoId) robot_node = linked;
   }
   if (robot_node == graph::kNoId) {
     out.status = LocalPlanStatus::kNoRobotNode;

@@ -238,6 +238,12 @@ class LocalPlanner {
   const graph::FrontierCluster* track_target(const LocalPlanInput& in);
   void remember_target(const LocalPlanInput& in, const graph::FrontierCluster& c);
   void build_search_graph(const graph::ReachableGraph& g);
+  // sg_ and robot_node_ for this cycle, if Stage 1 has not built them yet (a flight's foot is
+  // walked to before it, to_foot_of).
+  void ensure_search_graph(const LocalPlanInput& in);
+  // The nearest alive node with an edge within r (dz vertically) of p, else kNoId.
+  graph::NodeId linked_node_near(const graph::ReachableGraph& g, const Eigen::Vector3f& p, float r,
+                                 float dz);
   // Stage 3 to one viewpoint; on failure *why says A* or trajectory.
   bool free_start(const LocalPlanInput& in);
   // PlanOptions::no_progress_s: true once the robot stood that long with a target (then the
@@ -271,9 +277,10 @@ class LocalPlanner {
                 const FlightFoot* given = nullptr);
   // PlanOptions::flight_foot: cluster c, about to be set aside, has a flight's first riser near:
   // a new target at the flight's foot (flight_foot()), once per foot; false if none.
-  // The floor has no other target: to the foot of a flight that rises out of C_reach (a node's
-  // GraphNode::flight_lead on this floor, its foot not tried yet); false if none.
-  bool to_flight_lead(const LocalPlanInput& in, LocalPlanResult& out);
+  // The floor has no other target, or its graph stopped growing (stale): to the foot of a flight
+  // that rises out of C_reach (a node's GraphNode::flight_lead on this floor, its foot not tried
+  // yet); false if none.
+  bool to_flight_lead(const LocalPlanInput& in, LocalPlanResult& out, bool stale = false);
   bool to_flight_foot(const LocalPlanInput& in, const graph::FrontierCluster& c,
                       LocalPlanResult& out);
   // Stage 3 to f's stand point, else up to 0.75 m farther back on the axis (room to turn).
@@ -298,6 +305,7 @@ class LocalPlanner {
   StageProbe* probe_ = nullptr;
   GraphSearch search_, pair_search_;
   SearchGraph sg_;
+  bool sg_fresh_ = false;  // sg_ was built from this cycle's graph
   std::vector<SearchGraph::Edge> edges_scratch_;
   std::vector<Eigen::Vector3d> pos_scratch_;
 

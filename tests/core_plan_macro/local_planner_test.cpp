@@ -1024,8 +1024,9 @@ World walled_flight_room() {
 // walled_flight_room() seen from three places on the floor, with flight leads.
 void observe_walled_flight_room(Harness& h) {
   const World w = walled_flight_room();
-  for (const Eigen::Vector3f f : {Eigen::Vector3f(-2.5f, 0.1f, 0), Eigen::Vector3f(-1.5f, -1.2f, 0),
-                                  Eigen::Vector3f(-0.8f, 1.0f, 0)})
+  for (const Eigen::Vector3f& f :
+       {Eigen::Vector3f(-2.5f, 0.1f, 0), Eigen::Vector3f(-1.5f, -1.2f, 0),
+        Eigen::Vector3f(-0.8f, 1.0f, 0)})
     h.observe(w, f, 60000, 3);
 }
 }  // namespace
@@ -1099,4 +1100,98 @@ TEST(LocalPlanner, ATripToAFlightLeadCutShortIsTakenUpAgain) {
     }
   }
   EXPECT_EQ(trips, 3);  // the first trip and two more (kMaxLeadTrips)
+}
+
+// PlanOptions::stale_floor_s: once the floor's graph has stopped growing, a lead's flight is gone
+// to though other frontiers remain (teaching_building seed 1, session 23: frontiers kept coming
+// back near the stair hub, no cycle without a target came before 1800 s and the lead trip waited
+// for one). The harness's map is static: the graph never grows. The robot stays where it is
+// while it heads for the other frontier (periodic replans) and walks to a flight's foot.
+namespace {
+struct LeadRun {
+  std::vector<std::string> reasons;  // of each new trajectory, in order
+  bool climbed = false;              // a climb ending more than three treads up
+};
+
+LeadRun run_lead(double stale_floor_s) {
+  storey::core::graph::GraphOptions go;
+  go.climb_frontiers = true;
+  Harness h(go);
+  observe_walled_flight_room(h);
+  PlanOptions po;
+  po.climb_blind = true;
+  po.flight_foot = true;
+  po.stale_floor_s = stale_floor_s;
+  const auto view = h.map.view();
+  LocalPlanner lp(RobotModel{}, po, 0.1);
+  // One frontier cluster on the floor, the farthest from the flight's foot.
+  std::vector<storey::core::graph::FrontierCluster> clusters;
+  for (const auto& c : h.clusters.clusters())
+    if (c.centroid_m.z() < 0.1f &&
+        (clusters.empty() ||
+         c.centroid_m.head<2>().norm() > clusters[0].centroid_m.head<2>().norm()))
+      clusters = {c};
+  EXPECT_EQ(clusters.size(), 1u);
+  Eigen::Vector3f foot(-2.5f, 0.1f, 0);
+  double yaw = 0, t = 0;
+  LeadRun run;
+  for (int cycle = 0; cycle < 16 && !run.climbed; ++cycle) {
+    LocalPlanInput in = input(h, view, foot, t);
+    in.clusters = &clusters;
+    in.robot_yaw_rad = yaw;
+    in.last_resort = true;
+    const LocalPlanResult r = lp.plan(in);
+    t += 1.0;
+    if (r.status != LocalPlanStatus::kNewTrajectory) continue;
+    const std::string reason = r.replan_reason;
+    run.reasons.push_back(reason);
+    if (reason.rfind("to a flight's foot", 0) != 0 && reason.rfind("climb on", 0) != 0) continue;
+    const auto end = r.trajectory.pose(r.trajectory.t_end());  // walked to its end
+    foot = end.foot_m.cast<float>();
+    yaw = end.yaw_rad;
+    t = r.trajectory.t_end() + 1.5;
+    if (reason.rfind("climb on", 0) == 0 && foot.z() > 0.5f) run.climbed = true;
+  }
+  return run;
+}
+}  // namespace
+
+TEST(LocalPlanner, AFlightLeadIsGoneToOnceTheFloorsGraphStopsGrowing) {
+  const LeadRun wait = run_lead(0.0);  // off: the lead waits until the floor has no target
+  EXPECT_FALSE(any_starts_with(wait.reasons, "to a flight's foot"));
+  EXPECT_FALSE(wait.climbed);
+
+  const LeadRun stale = run_lead(5.0);  // the graph has not grown for 5 s
+  EXPECT_TRUE(any_starts_with(stale.reasons, "to a flight's foot: the floor's graph stopped"));
+  EXPECT_TRUE(stale.climbed);
+
+  const LeadRun late = run_lead(600.0);  // not stale within the run: as with it off
+  EXPECT_EQ(late.reasons, wait.reasons);
+}
+
+// The walk to a flight's foot follows G_real where the voxel A* gives up (here bounded to one
+// expansion; on a real floor, a trip across the building past its expansion limit): the foot is
+// no graph node, so the walk goes to the nearest linked one and on to the foot.
+TEST(LocalPlanner, AFlightsFootIsWalkedToAlongTheGraphWhereTheVoxelSearchGivesUp) {
+  storey::core::graph::GraphOptions go;
+  go.climb_frontiers = true;
+  Harness h(go);
+  observe_walled_flight_room(h);
+  PlanOptions po;
+  po.climb_blind = true;
+  po.flight_foot = true;
+  po.astar_max_expansions = 1;
+  const auto view = h.map.view();
+  LocalPlanner lp(RobotModel{}, po, 0.1);
+  const std::vector<storey::core::graph::FrontierCluster> none;
+  Eigen::Vector3f foot(-2.5f, 0.1f, 0);
+  double yaw = 0, t = 0;
+  const auto r = walked_cycle(lp, h, view, none, foot, yaw, t);
+  ASSERT_TRUE(r.has_value());
+  EXPECT_EQ(std::string(r->replan_reason).rfind("to a flight's foot", 0), 0u) << r->replan_reason;
+  EXPECT_GT(r->graph_fallbacks, 0);
+  // It ends at the foot's stand point (on the flight's axis, short of its first riser at x = 0).
+  EXPECT_LT(std::abs(foot.y()), 0.3f) << foot.transpose();
+  EXPECT_GT(foot.x(), -1.5f) << foot.transpose();
+  EXPECT_LT(foot.x(), 0.0f) << foot.transpose();
 }
