@@ -610,6 +610,20 @@ bool LocalPlanner::to_flight_lead(const LocalPlanInput& in, LocalPlanResult& out
   return false;
 }
 
+bool LocalPlanner::to_next_flight(const LocalPlanInput& in, LocalPlanResult& out) {
+  if (!plan_opt_.climb_blind || !plan_opt_.flight_foot) return false;
+  const auto f = flight_foot(*in.view, {in.robot_foot_m}, in.robot_foot_m.z(), 0.45, 2.0, 1.0,
+                             /*sparse=*/true);
+  if (!f || !free_start(in) || !to_foot_of(in, *f, out)) return false;
+  flight_foot_ = *f;
+  graph::FrontierCluster c;
+  c.centroid_m = f->foot_m.cast<float>();
+  adopt_target(in, c, out);
+  flight_target_ = next_flight_ = true;
+  out.replan_reason = "to a flight's foot: from the landing, the next flight up";
+  return true;
+}
+
 bool LocalPlanner::straight_walk(const LocalPlanInput& in, const std::vector<Eigen::Vector3d>& pts,
                                  double yaw, LocalPlanResult& out) {
   auto w = plan::straight_walk(checker_, *in.view, robot_, pts, yaw, in.t_s);
@@ -1009,7 +1023,8 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   };
   // The target is a flight's foot (to_flight_foot): kept only by a kKeep.
   const bool flight_target = flight_target_;
-  flight_target_ = false;
+  const bool next_flight = next_flight_;
+  flight_target_ = next_flight_ = false;
   // A climb found while other frontiers are left: kept for last (climb_on's walk dropped).
   auto defer_climb = [&]() {
     --climbs_;
@@ -1085,6 +1100,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
       has_target_ = false;
     } else if (!committed_ && !climb_start_ && reached && (tc || flight_target) &&
                try_climb(false, flight_target ? &flight_foot_ : nullptr)) {
+      if (next_flight) return commit_climb("climb on: from the landing up the next flight");
       const int others = other_targets(in, tc ? tc->id : -1);
       if (others == 0)
         return commit_climb("climb on: a frontier on a flight is not seen from on it");
@@ -1150,6 +1166,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
       } else {
         out.status = LocalPlanStatus::kKeep;
         flight_target_ = flight_target;
+        next_flight_ = next_flight;
         out.target_cluster = target_cluster_;
         out.target_m = target_m_;
         out.real_until_s = current_.t_end();
@@ -1201,6 +1218,10 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     // from here.
     if (below_climbed_landing(in.robot_foot_m) && try_climb(true))
       return commit_climb("climb on: the climb stopped on the flight, on up it");
+    // On a landing a flight rises from (a U-shaped stair's return flight): on up it first.
+    // Otherwise the floor below, reachable again down the flight just climbed, drew the robot
+    // back down to its frontiers (teaching_building seed 1, session 24).
+    if (!partial && to_next_flight(in, out)) return out;
   }
   // No other target left on this floor: back to the flight left for last, or up it from there.
   bool climb_escape = false;  // climb_last found no way back but an escape

@@ -283,6 +283,9 @@ class LocalPlanner {
   bool to_flight_lead(const LocalPlanInput& in, LocalPlanResult& out, bool stale = false);
   bool to_flight_foot(const LocalPlanInput& in, const graph::FrontierCluster& c,
                       LocalPlanResult& out);
+  // A climb ended on a landing: to the foot of a flight rising from it within 2 m (the return
+  // flight of a U-shaped stair), climbed from there whatever else is left; false if none.
+  bool to_next_flight(const LocalPlanInput& in, LocalPlanResult& out);
   // Stage 3 to f's stand point, else up to 0.75 m farther back on the axis (room to turn).
   bool to_foot_of(const LocalPlanInput& in, const FlightFoot& f, LocalPlanResult& out);
   // Boxed in on a flight (every Stage 3 body hit next to the start): straight down the flight's
@@ -390,6 +393,7 @@ class LocalPlanner {
       approached_;              // clusters whose viewpoint was reached once (walk onto them next)
   bool flight_target_ = false;  // the target is a flight's foot (to_flight_foot) ...
   FlightFoot flight_foot_;      // ... this one
+  bool next_flight_ = false;    // ... from a landing, its next flight's (to_next_flight)
   std::vector<Eigen::Vector3f> flight_feet_tried_;  // each foot is a target once
 };
 

@@ -231,7 +231,8 @@ std::optional<FlightAxis> flight_axis(const map::MapView& view, const Eigen::Vec
 
 std::optional<FlightFoot> flight_foot(const map::MapView& view,
                                       const std::vector<Eigen::Vector3d>& near, double floor_z,
-                                      double back_m, double radius_m, double run_up_m) {
+                                      double back_m, double radius_m, double run_up_m,
+                                      bool sparse) {
   if (near.empty() || !std::isfinite(floor_z)) return std::nullopt;
   const RobotModel& r = view.robot();
   const double s = view.voxel_size_m(), step = r.step_height_m;
@@ -275,41 +276,52 @@ std::optional<FlightFoot> flight_foot(const map::MapView& view,
       }
     }
   if (edges.empty()) return std::nullopt;
-  // The riser line: the points facing one way within 0.2 m across and 1.5 m along a line
-  // through one of them, the line with the most (ties: nearest the cluster).
-  const auto line_of = [&](const Edge& e0, std::vector<Eigen::Vector2d>* pts) {
+  // The riser line: the points facing one way (or, with `neighbours`, its way or one 45 deg
+  // from it) within 0.2 m across and 1.5 m along a line through one of them, the line with the
+  // most (ties: nearest the cluster); its middle c and normal up (the principal axis of its
+  // points: the 8 search directions are 45 deg apart). False: fewer than 3 points.
+  const auto line_of = [&](const Edge& e0, double min_dot, std::vector<Eigen::Vector2d>* pts) {
     const Eigen::Vector2d t0(-e0.n.y(), e0.n.x());
     int n = 0;
     for (const Edge& e : edges) {
       const Eigen::Vector2d dp = e.p - e0.p;
-      if (e.n.dot(e0.n) < 0.99 || std::abs(dp.dot(e0.n)) > 0.2 || std::abs(dp.dot(t0)) > 1.5)
+      if (e.n.dot(e0.n) < min_dot || std::abs(dp.dot(e0.n)) > 0.2 || std::abs(dp.dot(t0)) > 1.5)
         continue;
       if (pts) pts->push_back(e.p);
       ++n;
     }
     return n;
   };
+  Eigen::Vector2d c, up;
   const Edge* best = nullptr;
-  int best_n = 0;
-  for (const Edge& e : edges) {
-    const int n = line_of(e, nullptr);
-    if (n > best_n || (n == best_n && e.d < best->d)) best = &e, best_n = n;
-  }
-  std::vector<Eigen::Vector2d> line;
-  if (line_of(*best, &line) < 3) return std::nullopt;
-  // The riser's direction from its points (principal axis; the 8 search directions are 45 deg
-  // apart) and its middle.
-  Eigen::Vector2d c = Eigen::Vector2d::Zero();
-  for (const Eigen::Vector2d& p : line) c += p;
-  c /= double(line.size());
-  double sxx = 0, sxy = 0, syy = 0;
-  for (const Eigen::Vector2d& p : line) {
-    const Eigen::Vector2d d = p - c;
-    sxx += d.x() * d.x(), sxy += d.x() * d.y(), syy += d.y() * d.y();
-  }
-  const double th = 0.5 * std::atan2(2.0 * sxy, sxx - syy);  // the riser's own direction
-  Eigen::Vector2d up(-std::sin(th), std::cos(th));
-  if (up.dot(best->n) < 0) up = -up;
+  const auto riser = [&](bool neighbours) {
+    const double min_dot = neighbours ? 0.7 : 0.99;
+    int best_n = 0;
+    for (const Edge& e : edges) {
+      const int n = line_of(e, min_dot, nullptr);
+      if (n > best_n || (n == best_n && e.d < best->d)) best = &e, best_n = n;
+    }
+    std::vector<Eigen::Vector2d> line;
+    if (line_of(*best, min_dot, &line) < 3) return false;
+    c = Eigen::Vector2d::Zero();
+    for (const Eigen::Vector2d& p : line) c += p;
+    c /= double(line.size());
+    double sxx = 0, sxy = 0, syy = 0;
+    for (const Eigen::Vector2d& p : line) {
+      const Eigen::Vector2d d = p - c;
+      sxx += d.x() * d.x(), sxy += d.x() * d.y(), syy += d.y() * d.y();
+    }
+    const double th = 0.5 * std::atan2(2.0 * sxy, sxx - syy);  // the riser's own direction
+    up = Eigen::Vector2d(-std::sin(th), std::cos(th));
+    if (up.dot(best->n) < 0) up = -up;
+    return true;
+  };
+  if (!riser(false)) return std::nullopt;
+  // A riser faces within 22.5 deg of one search direction. Its line found in another (a riser
+  // seen sparsely passes for a diagonal direction more often than for its own: the return flight
+  // of a U-shaped stair seen from its landing, teaching_building seed 1, session 24): found again
+  // with each direction's neighbours counted in.
+  if (sparse && up.dot(best->n) < std::cos(M_PI / 8) && !riser(true)) return std::nullopt;
   if (up.dot(best->n) < std::cos(M_PI / 4)) return std::nullopt;  // not a line across the search
   // The axis: flight_axis's (its direction from the tread heights and the risers' normals, its
   // line centred between the side walls) where it agrees with the riser's normal within 25 deg;

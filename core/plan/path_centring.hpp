@@ -60,10 +60,14 @@ struct FlightFoot {
   FlightAxis axis;
   Eigen::Vector3d riser_m = Eigen::Vector3d::Zero();  // middle of the first riser, at the floor
 };
+// sparse: a riser line whose points' normal is nearer another search direction than the one it
+// was found in is found again with each direction's neighbours counted in (a flight seen
+// sparsely, as the return flight of a U-shaped stair from its landing; off elsewhere: more
+// feet found on the office's floors cost it 57-158 s, session 24).
 std::optional<FlightFoot> flight_foot(const map::MapView& view,
                                       const std::vector<Eigen::Vector3d>& near, double floor_z,
                                       double back_m = 0.45, double radius_m = 1.5,
-                                      double run_up_m = 1.0);
+                                      double run_up_m = 1.0, bool sparse = false);
 
 struct FlightShaping {
   int flights = 0;                 // flights re-laid on their axis

@@ -241,3 +241,61 @@ TEST(PathCentring, VoxelBoxesAreFittedToTheirPoints) {
   EXPECT_FALSE(cc.check_poses(view, std::span<const BodyPose>(&near, 1)).collides);
   EXPECT_TRUE(cc.check_poses(view, std::span<const BodyPose>(&into, 1)).collides);
 }
+
+namespace {
+// A U-shaped return stair as in the teaching building (0.168 m risers, 0.29 m treads, 1.2 m
+// flights 0.2 m apart): flight 1 rises along +x from x = 0 to a landing (x 2.32..3.72, top
+// 1.516 m), flight 2 runs back along -x from the landing, beside flight 1 (y 0.8..2.0).
+storey::test::World u_stair_world() {
+  storey::test::World w;
+  const float rise = 0.168f, run = 0.29f;
+  w.add(aabb({-4, -3, -0.2f}, {6, 4, 0}));
+  w.stairs(0.0f, -0.6f, 0.6f, 0.0f, 8, rise, run);
+  w.add(aabb({2.32f, -0.6f, -0.2f}, {3.72f, 2.0f, 9 * rise}));  // the landing
+  for (int k = 0; k < 9; ++k)  // flight 2: tread k from the landing's edge back along -x
+    w.add(aabb({2.32f - (k + 1) * run, 0.8f, -0.2f}, {2.32f - k * run, 2.0f, (10 + k) * rise}));
+  w.add(aabb({-0.29f, -0.72f, 0}, {3.84f, -0.6f, 4.2f}));  // outer walls
+  w.add(aabb({-0.29f, 2.0f, 0}, {3.84f, 2.12f, 4.2f}));
+  w.add(aabb({-0.29f, 0.6f, 0}, {2.32f, 0.8f, 4.2f}));    // the wall between the flights
+  w.add(aabb({3.72f, -0.72f, 0}, {3.84f, 2.12f, 4.2f}));  // the landing's end wall
+  return w;
+}
+}  // namespace
+
+// On the landing after climbing flight 1 (standing where the climb ended, facing on along +x):
+// the foot of flight 2 is on the landing beside it, facing back along -x (teaching_building
+// seed 1, session 24: a foot found there with a diagonal axis and no climb from it).
+TEST(PathCentring, FlightFootOfAReturnFlightIsFoundFromItsLanding) {
+  const storey::test::World w = u_stair_world();
+  map::TraversabilityMap m;
+  uint32_t seed = 1;
+  for (float x : {-2.0f, -1.0f})  // walking up to flight 1
+    for (int r = 0; r < 5; ++r) {
+      const Eigen::Vector3f o(x, 0.05f * r - 0.1f, 0.44f);
+      m.insert_scan(o, storey::test::scan_vlp16(w, o, 0.1f * r, seed++));
+    }
+  for (int k : {2, 4, 6, 7})  // climbing it (on tread k)
+    for (int r = 0; r < 3; ++r) {
+      const Eigen::Vector3f o(0.29f * k + 0.15f, 0.05f * r - 0.05f, 0.168f * (k + 1) + 0.44f);
+      m.insert_scan(o, storey::test::scan_vlp16(w, o, 0.1f * r, seed++));
+    }
+  for (int r = 0; r < 10; ++r) {  // standing on the landing
+    const Eigen::Vector3f o(2.93f, 0.04f + 0.01f * r, 1.516f + 0.44f);
+    m.insert_scan(o, storey::test::scan_vlp16(w, o, 0.1f * r, seed++));
+  }
+  m.update_traversability();
+  m.update_reachable({2.93f, 0.04f, 1.516f});
+  const map::MapView view = m.view();
+  const std::vector<Vector3d> near = {{2.93, 0.04, 1.516}, {3.2, 0.5, 1.516}};
+  const auto f = flight_foot(view, near, 1.516, 0.45, 1.5, 1.0, /*sparse=*/true);
+  ASSERT_TRUE(f.has_value());
+  EXPECT_NEAR(f->riser_m.x(), 2.32, 0.1) << f->riser_m.transpose();
+  EXPECT_NEAR(f->foot_m.y(), 1.4, 0.15) << f->foot_m.transpose();
+  EXPECT_GT(f->foot_m.x(), 2.32 + 0.3) << f->foot_m.transpose();
+  EXPECT_NEAR(f->foot_m.z(), 1.516, 0.05);
+  EXPECT_NEAR(std::abs(f->yaw_rad), M_PI, 0.15);
+  // Without `sparse` the riser is the diagonal line's: a foot off the flight's axis.
+  const auto g = flight_foot(view, near, 1.516);
+  ASSERT_TRUE(g.has_value());
+  EXPECT_GT(std::abs(std::abs(g->yaw_rad) - M_PI), 0.15) << g->yaw_rad;
+}

@@ -1195,3 +1195,78 @@ TEST(LocalPlanner, AFlightsFootIsWalkedToAlongTheGraphWhereTheVoxelSearchGivesUp
   EXPECT_GT(foot.x(), -1.5f) << foot.transpose();
   EXPECT_LT(foot.x(), 0.0f) << foot.transpose();
 }
+
+// A U-shaped return stair (as in the teaching building): flight 1 along +x to a landing walled
+// ahead, flight 2 back along -x beside it. The climb of flight 1 ends on the landing; from there
+// the robot is sent to flight 2's foot, facing up it, whatever else is left below
+// (teaching_building seed 1, session 24: from the landing the robot was sent back down flight 1
+// to the ground floor's frontiers, reachable again through it, and flight 2 was never climbed).
+// The climb from that foot is measured in the simulator (docs/RESULTS.md "Session 24"): on this
+// harness's static map Stage 3's path centring ends the walk 0.25 m off the axis and the climb
+// from there finds no flight.
+namespace {
+World u_stair_room() {
+  World w;
+  const float rise = 0.168f, run = 0.29f;
+  w.add({-4, -3, -0.2f}, {6, 4, 0});
+  w.stairs(0.0f, -0.6f, 0.6f, 0.0f, 8, rise, run);
+  w.add({2.32f, -0.6f, -0.2f}, {3.72f, 2.0f, 9 * rise});  // the landing
+  for (int k = 0; k < 9; ++k)  // flight 2, back along -x from the landing's edge
+    w.add({2.32f - (k + 1) * run, 0.8f, -0.2f}, {2.32f - k * run, 2.0f, (10 + k) * rise});
+  w.add({-0.29f, -0.72f, 0}, {3.84f, -0.6f, 4.2f});  // outer walls
+  w.add({-0.29f, 2.0f, 0}, {3.84f, 2.12f, 4.2f});
+  w.add({-0.29f, 0.6f, 0}, {2.32f, 0.8f, 4.2f});    // between the flights
+  w.add({3.72f, -0.72f, 0}, {3.84f, 2.12f, 4.2f});  // the landing's end wall
+  w.add({-4, -3.2f, 0}, {6, -3, 4.5f});             // the room's walls
+  w.add({-4, 4, 0}, {6, 4.2f, 4.5f});
+  w.add({-4.2f, -3, 0}, {-4, 4, 4.5f});
+  return w;
+}
+}  // namespace
+
+TEST(LocalPlanner, FromTheLandingOfAUShapedStairTheRobotGoesToItsReturnFlight) {
+  storey::core::graph::GraphOptions go;
+  go.climb_frontiers = true;
+  Harness h(go);
+  const World w = u_stair_room();
+  for (const Eigen::Vector3f& f :
+       {Eigen::Vector3f(-2.5f, 0.1f, 0), Eigen::Vector3f(-1.5f, -1.2f, 0),
+        Eigen::Vector3f(-1.5f, 2.5f, 0)})
+    h.observe(w, f, 60000, 3);
+  PlanOptions po;
+  po.climb_blind = true;
+  po.flight_foot = true;
+  LocalPlanner lp(RobotModel{}, po, 0.1);
+  // The frontier on flight 1's lower treads (seen from the floor); the robot climbs from its foot.
+  std::vector<storey::core::graph::FrontierCluster> on_flight;
+  for (const auto& c : h.clusters.clusters())
+    if (c.centroid_m.z() > 0.1f) on_flight.push_back(c);
+  ASSERT_FALSE(on_flight.empty());
+  Eigen::Vector3f foot(-2.5f, 0.1f, 0);
+  double yaw = 0, t = 0;
+  bool on_landing = false;
+  std::optional<LocalPlanResult> next;
+  for (int cycle = 0; cycle < 8 && !next; ++cycle) {
+    const auto view = h.map.view();
+    const auto r = walked_cycle(lp, h, view, on_flight, foot, yaw, t);
+    if (!r) continue;
+    if (on_landing) next = r;  // the first plan once the climb has ended there
+    if (!on_landing && std::abs(foot.z() - 1.512f) < 0.1f && foot.x() > 2.4f) {
+      on_landing = true;  // the robot stands on the landing and looks round
+      foot.z() = 9 * 0.168f;
+      h.observe(w, foot, 60000, 5);
+      h.observe(w, foot + Eigen::Vector3f(0.2f, 0.6f, 0), 60000, 6);
+    }
+  }
+  ASSERT_TRUE(on_landing);
+  ASSERT_TRUE(next.has_value());
+  EXPECT_EQ(std::string(next->replan_reason).rfind("to a flight's foot: from the landing", 0), 0u)
+      << next->replan_reason;
+  // Flight 2's foot: on the landing before its first riser (x 2.32), in its lane (y 0.8..2.0),
+  // facing back along -x.
+  EXPECT_GT(next->target_m.x(), 2.32 + 0.3) << next->target_m.transpose();
+  EXPECT_GT(next->target_m.y(), 1.0) << next->target_m.transpose();
+  EXPECT_LT(next->target_m.y(), 1.8) << next->target_m.transpose();
+  EXPECT_NEAR(next->target_m.z(), 1.512, 0.05);
+  EXPECT_NEAR(std::abs(next->target_yaw_rad), M_PI, 0.2);
+}
