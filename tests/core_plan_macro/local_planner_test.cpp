@@ -1029,6 +1029,21 @@ void observe_walled_flight_room(Harness& h) {
         Eigen::Vector3f(-0.8f, 1.0f, 0)})
     h.observe(w, f, 60000, 3);
 }
+
+// Graph options with flight leads (climb_frontiers).
+storey::core::graph::GraphOptions lead_options() {
+  storey::core::graph::GraphOptions go;
+  go.climb_frontiers = true;
+  return go;
+}
+
+// The defaults' climbing switches: blind climbs from a flight's foot.
+PlanOptions climbing_options() {
+  PlanOptions po;
+  po.climb_blind = true;
+  po.flight_foot = true;
+  return po;
+}
 }  // namespace
 
 TEST(LocalPlanner, WithNoFrontierLeftTheRobotClimbsAFlightThatRisesOutOfReach) {
@@ -1073,13 +1088,9 @@ TEST(LocalPlanner, WithNoFrontierLeftTheRobotClimbsAFlightThatRisesOutOfReach) {
 // seed 1, session 23: frontiers came back on the way and the foot, tried once, was never tried
 // again) is taken up again once the floor has no target, a bounded number of times.
 TEST(LocalPlanner, ATripToAFlightLeadCutShortIsTakenUpAgain) {
-  storey::core::graph::GraphOptions go;
-  go.climb_frontiers = true;
-  Harness h(go);
+  Harness h(lead_options());
   observe_walled_flight_room(h);
-  PlanOptions po;
-  po.climb_blind = true;
-  po.flight_foot = true;
+  PlanOptions po = climbing_options();
   const auto view = h.map.view();
   LocalPlanner lp(RobotModel{}, po, 0.1);
   const std::vector<storey::core::graph::FrontierCluster> none;
@@ -1114,13 +1125,9 @@ struct LeadRun {
 };
 
 LeadRun run_lead(double stale_floor_s) {
-  storey::core::graph::GraphOptions go;
-  go.climb_frontiers = true;
-  Harness h(go);
+  Harness h(lead_options());
   observe_walled_flight_room(h);
-  PlanOptions po;
-  po.climb_blind = true;
-  po.flight_foot = true;
+  PlanOptions po = climbing_options();
   po.stale_floor_s = stale_floor_s;
   const auto view = h.map.view();
   LocalPlanner lp(RobotModel{}, po, 0.1);
@@ -1173,13 +1180,9 @@ TEST(LocalPlanner, AFlightLeadIsGoneToOnceTheFloorsGraphStopsGrowing) {
 // expansion; on a real floor, a trip across the building past its expansion limit): the foot is
 // no graph node, so the walk goes to the nearest linked one and on to the foot.
 TEST(LocalPlanner, AFlightsFootIsWalkedToAlongTheGraphWhereTheVoxelSearchGivesUp) {
-  storey::core::graph::GraphOptions go;
-  go.climb_frontiers = true;
-  Harness h(go);
+  Harness h(lead_options());
   observe_walled_flight_room(h);
-  PlanOptions po;
-  po.climb_blind = true;
-  po.flight_foot = true;
+  PlanOptions po = climbing_options();
   po.astar_max_expansions = 1;
   const auto view = h.map.view();
   LocalPlanner lp(RobotModel{}, po, 0.1);
@@ -1225,18 +1228,13 @@ World u_stair_room() {
 }  // namespace
 
 TEST(LocalPlanner, FromTheLandingOfAUShapedStairTheRobotGoesToItsReturnFlight) {
-  storey::core::graph::GraphOptions go;
-  go.climb_frontiers = true;
-  Harness h(go);
+  Harness h(lead_options());
   const World w = u_stair_room();
   for (const Eigen::Vector3f& f :
        {Eigen::Vector3f(-2.5f, 0.1f, 0), Eigen::Vector3f(-1.5f, -1.2f, 0),
         Eigen::Vector3f(-1.5f, 2.5f, 0)})
     h.observe(w, f, 60000, 3);
-  PlanOptions po;
-  po.climb_blind = true;
-  po.flight_foot = true;
-  LocalPlanner lp(RobotModel{}, po, 0.1);
+  LocalPlanner lp(RobotModel{}, climbing_options(), 0.1);
   // The frontier on flight 1's lower treads (seen from the floor); the robot climbs from its foot.
   std::vector<storey::core::graph::FrontierCluster> on_flight;
   for (const auto& c : h.clusters.clusters())
