@@ -573,11 +573,7 @@ bool LocalPlanner::to_flight_lead(const LocalPlanInput& in, LocalPlanResult& out
     ++lead_trip_->trips;
     flight_foot_ = lead_trip_->foot;
     if (free_start(in) && to_foot_of(in, flight_foot_, out)) {
-      graph::FrontierCluster c;
-      c.centroid_m = flight_foot_.foot_m.cast<float>();
-      adopt_target(in, c, out);
-      flight_target_ = true;
-      out.replan_reason = reason;
+      adopt_foot(in, flight_foot_, reason, out);
       return true;
     }
   }
@@ -615,13 +611,19 @@ bool LocalPlanner::to_next_flight(const LocalPlanInput& in, LocalPlanResult& out
   const auto f = flight_foot(*in.view, {in.robot_foot_m}, in.robot_foot_m.z(), 0.45, 2.0, 1.0,
                              /*sparse=*/true);
   if (!f || !free_start(in) || !to_foot_of(in, *f, out)) return false;
-  flight_foot_ = *f;
-  graph::FrontierCluster c;
-  c.centroid_m = f->foot_m.cast<float>();
-  adopt_target(in, c, out);
-  flight_target_ = next_flight_ = true;
-  out.replan_reason = "to a flight's foot: from the landing, the next flight up";
+  adopt_foot(in, *f, "to a flight's foot: from the landing, the next flight up", out);
+  next_flight_ = true;
   return true;
+}
+
+void LocalPlanner::adopt_foot(const LocalPlanInput& in, const FlightFoot& f, const char* reason,
+                              LocalPlanResult& out) {
+  flight_foot_ = f;
+  graph::FrontierCluster c;  // no frontier: the foot itself is the target
+  c.centroid_m = f.foot_m.cast<float>();
+  adopt_target(in, c, out);
+  flight_target_ = true;
+  out.replan_reason = reason;
 }
 
 bool LocalPlanner::straight_walk(const LocalPlanInput& in, const std::vector<Eigen::Vector3d>& pts,

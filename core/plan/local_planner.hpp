@@ -286,6 +286,9 @@ class LocalPlanner {
   // A climb ended on a landing: to the foot of a flight rising from it within 2 m (the return
   // flight of a U-shaped stair), climbed from there whatever else is left; false if none.
   bool to_next_flight(const LocalPlanInput& in, LocalPlanResult& out);
+  // The planned walk (out) leads to flight f's foot: f becomes the target, with no frontier.
+  void adopt_foot(const LocalPlanInput& in, const FlightFoot& f, const char* reason,
+                  LocalPlanResult& out);
   // Stage 3 to f's stand point, else up to 0.75 m farther back on the axis (room to turn).
   bool to_foot_of(const LocalPlanInput& in, const FlightFoot& f, LocalPlanResult& out);
   // Boxed in on a flight (every Stage 3 body hit next to the start): straight down the flight's
