@@ -245,6 +245,17 @@ constexpr float kStairGrade = 0.466f;  // tan(25 deg)
 constexpr int kStairSteps = 2;
 }  // namespace
 
+bool SupportQuery::wall_face(const Support& top, const Eigen::Vector2f& dir) {
+  const float x = (float(top.key.x) + 0.5f) * vs_, y = (float(top.key.y) + 0.5f) * vs_;
+  for (int d = 1; d <= 2; ++d) {
+    const int32_t kx = int32_t(std::floor((x + dir.x() * vs_ * float(d)) * inv_vs_));
+    const int32_t ky = int32_t(std::floor((y + dir.y() * vs_ * float(d)) * inv_vs_));
+    if (occupied(cell({kx, ky, top.key.z + 1})) && occupied(cell({kx, ky, top.key.z + 2})))
+      return true;
+  }
+  return false;
+}
+
 bool SupportQuery::probe_open_climbing(const Eigen::Vector3f& foot, const Eigen::Vector2f& dir,
                                        float length_m, float height_m, float min_free_m,
                                        float min_unknown_m, bool* climbed, bool* leaves_reach) {
@@ -275,7 +286,8 @@ bool SupportQuery::probe_open_climbing(const Eigen::Vector3f& foot, const Eigen:
     const std::optional<Support> top = surface_near(hx, hy, zc + 0.5f * max_rise, 0.5f * max_rise);
     const float rise = top ? top->p_m.z() - zc : 0.0f;
     if (top && rise > 0.5f * vs_ && rise <= max_rise &&
-        rise <= step_ + tan_slope_ * std::max(0.0f, s_hit - s_climb)) {
+        rise <= step_ + tan_slope_ * std::max(0.0f, s_hit - s_climb) &&
+        !(opt_.close_probes_at_wall_faces && wall_face(*top, dir))) {
       // A step up onto support the LiDAR saw only edge-on (a tread seen from below: its
       // riser's top, N(v) < N_min): terrain not yet observed, what the probe looks for.
       // A stair's step: steeper than tan(25 deg) since the last climb (flights ~30 deg; a ramp,

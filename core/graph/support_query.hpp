@@ -119,6 +119,11 @@ class SupportQuery {
   };
   ProbeSegment probe_segment(const Eigen::Vector3f& from, const Eigen::Vector3f& to, int need_free,
                              int* free_total, int* unknown_run);
+  // `top` lies on a wall's face, no step: the obstacle rises on behind it (one or two voxels
+  // further along dir, the two voxels over top's height occupied). A face that straddles a voxel
+  // boundary is hit at some heights only, and each hit voxel with free space over it looks
+  // like a tread seen edge-on (teaching_building: C_exp frontiers along explored rooms' walls).
+  bool wall_face(const Support& top, const Eigen::Vector2f& dir);
   // Unknown voxel k between two occupied voxels on one axis: a gap in a surface.
   bool hole_in_surface(const map::VoxelKey& k);
 

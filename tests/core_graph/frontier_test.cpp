@@ -370,6 +370,62 @@ TEST(TopologicalFrontiers, ProbeThroughAHoleInAWallIsClosed) {
   }
 }
 
+// A wall's face that straddles a voxel boundary is hit at some heights only: a voxel of the face
+// with free space over it looks like a tread seen edge-on (N(v) < N_min), and a probe "steps up"
+// onto it into open terrain (teaching_building seed 1: C_exp frontiers along every explored
+// room's walls drew the robot back for 300 s). With graph.close_probes_at_wall_faces the wall
+// rising on behind that voxel closes the probe; a flight's treads still let it climb.
+TEST(TopologicalFrontiers, AWallsFaceIsNoStepWithCloseProbesAtWallFaces) {
+  storey::core::map::TraversabilityMap m;
+  std::vector<Vector3f> pts;
+  for (float x = -1.95f; x < 2.0f; x += 0.1f)  // floor, up to the wall
+    for (float y = -1.95f; y < 2.0f; y += 0.1f) pts.push_back({x, y, -0.05f});
+  for (float y = -1.95f; y < 2.0f; y += 0.1f)  // wall: face voxels x 2.0-2.1, solid behind
+    for (float z = 0.05f; z < 1.5f; z += 0.1f)
+      for (const float x : {2.05f, 2.15f}) pts.push_back({x, y, z});
+  // The face's near voxel column (x 1.9-2.0) hit at 0.3-0.4 m only (rays carve it free above
+  // and below): one return straight ahead of the robot.
+  const Vector3f face(1.99f, 0.05f, 0.35f);
+  for (const float ox : {0.0f, 1.0f})
+    for (const float oy : {-0.5f, 0.0f, 0.5f}) {
+      std::vector<Vector3f> scan = pts;
+      scan.push_back(face);
+      m.insert_scan(Vector3f(ox, oy, 0.55f), scan);
+      m.update_traversability();
+    }
+  const Vector3f foot(0.05f, 0.05f, 0.0f);
+  for (const bool on : {false, true}) {
+    SCOPED_TRACE(on ? "graph.close_probes_at_wall_faces on" : "off");
+    GraphOptions opt;
+    opt.close_probes_at_wall_faces = on;
+    SupportQuery q(m.view(), opt);
+    EXPECT_EQ(q.probe_open_climbing(foot, Eigen::Vector2f(1, 0), 3.0f, 0.3f, 0.2f, 0.3f), !on);
+    // Beside it, where the face is hit at every height: closed either way.
+    EXPECT_FALSE(q.probe_open_climbing(Vector3f(0.05f, -1.05f, 0.0f), Eigen::Vector2f(1, 0), 3.0f,
+                                       0.3f, 0.2f, 0.3f));
+  }
+}
+
+// ... and up a flight of stairs the probe climbs as before: behind each riser's top lies its
+// tread, free over it.
+TEST(TopologicalFrontiers, ProbeClimbsAFlightWithCloseProbesAtWallFaces) {
+  World w;
+  w.add({-3.2f, -2, -0.3f}, {6, 2, 0.0f});
+  w.stairs(0.0f, -0.6f, 0.6f, 0.0f, 12, 0.17f, 0.29f);
+  w.add({0, -0.72f, 0}, {3.5f, -0.6f, 2.5f});  // side walls
+  w.add({0, 0.6f, 0}, {3.5f, 0.72f, 2.5f});
+  w.add({-3.2f, -2, 0}, {-3.0f, 2, 2.5f});  // a wall behind the robot
+  GraphOptions o;
+  o.close_probes_at_wall_faces = true;
+  Harness h(o);
+  h.observe(w, Vector3f(-1.5f, 0, 0.55f), Vector3f(-1.5f, 0, 0), 150000, 7, 6.0f);
+  SupportQuery q(h.map.view(), o);
+  bool climbed = false;
+  EXPECT_TRUE(q.probe_open_climbing(Vector3f(-0.3f, 0, 0), Eigen::Vector2f(1, 0), 3.0f, 0.3f, 0.2f,
+                                    0.3f, &climbed));
+  EXPECT_TRUE(climbed);
+}
+
 // GraphOptions::surface_seen_from_above: a 0.2 m slab seen from the floor below, then its top
 // seen from above near one end only. Off, Eq. 5 takes the slab's underside, within a step of the
 // upper floor's nodes, for the floor beyond what was seen: no node there is C_sur (test_ramp
