@@ -291,16 +291,23 @@ TEST(GraphExport, JsonAndPlyDescribeTheGraph) {
 // C_exp up a stair flight (paper III-C): seen from the floor with the sensor at 0.55 m, the risers
 // are observed but the treads above the sensor are not. A probe at body height hits the second
 // riser; the climbing probe steps up the observed treads and reaches the unknown ones.
-TEST(TopologicalFrontiers, ProbeClimbsAStairFlightToItsUnknownTreads) {
+namespace {
+// A 12-step flight from x = 0 between side walls, seen from its foot 1.5 m back.
+void observe_flight_from_its_foot(Harness& h) {
   World w;
   w.add({-3.2f, -2, -0.3f}, {6, 2, 0.0f});
   w.stairs(0.0f, -0.6f, 0.6f, 0.0f, 12, 0.17f, 0.29f);
   w.add({0, -0.72f, 0}, {3.5f, -0.6f, 2.5f});  // side walls
   w.add({0, 0.6f, 0}, {3.5f, 0.72f, 2.5f});
   w.add({-3.2f, -2, 0}, {-3.0f, 2, 2.5f});  // a wall behind the robot
+  h.observe(w, Vector3f(-1.5f, 0, 0.55f), Vector3f(-1.5f, 0, 0), 150000, 7, 6.0f);
+}
+}  // namespace
+
+TEST(TopologicalFrontiers, ProbeClimbsAStairFlightToItsUnknownTreads) {
   GraphOptions o;
   Harness h(o);
-  h.observe(w, Vector3f(-1.5f, 0, 0.55f), Vector3f(-1.5f, 0, 0), 150000, 7, 6.0f);
+  observe_flight_from_its_foot(h);
   SupportQuery q(h.map.view(), o);
   const Vector3f foot(-0.3f, 0, 0);
   const Eigen::Vector2f up(1, 0), back(-1, 0);
@@ -409,16 +416,10 @@ TEST(TopologicalFrontiers, AWallsFaceIsNoStepWithCloseProbesAtWallFaces) {
 // ... and up a flight of stairs the probe climbs as before: behind each riser's top lies its
 // tread, free over it.
 TEST(TopologicalFrontiers, ProbeClimbsAFlightWithCloseProbesAtWallFaces) {
-  World w;
-  w.add({-3.2f, -2, -0.3f}, {6, 2, 0.0f});
-  w.stairs(0.0f, -0.6f, 0.6f, 0.0f, 12, 0.17f, 0.29f);
-  w.add({0, -0.72f, 0}, {3.5f, -0.6f, 2.5f});  // side walls
-  w.add({0, 0.6f, 0}, {3.5f, 0.72f, 2.5f});
-  w.add({-3.2f, -2, 0}, {-3.0f, 2, 2.5f});  // a wall behind the robot
   GraphOptions o;
   o.close_probes_at_wall_faces = true;
   Harness h(o);
-  h.observe(w, Vector3f(-1.5f, 0, 0.55f), Vector3f(-1.5f, 0, 0), 150000, 7, 6.0f);
+  observe_flight_from_its_foot(h);
   SupportQuery q(h.map.view(), o);
   bool climbed = false;
   EXPECT_TRUE(q.probe_open_climbing(Vector3f(-0.3f, 0, 0), Eigen::Vector2f(1, 0), 3.0f, 0.3f, 0.2f,
