@@ -119,6 +119,29 @@ TEST(CollisionChecker, TerrainPitchNeedsSupportUnderBothEnds) {
   EXPECT_GT(*tp, 0.1);
 }
 
+// A walk from a flight's top tread onto its landing over the unseen tread between: the path rises
+// 0.33 m in 0.3 m and the pose's pitch (48 deg) would put the body's rear into the tread it
+// stands on. With the end ahead unseen and the one behind seen below the foot, the pitch is
+// bounded so that the rear stands no lower than that tread (office seed 1, session 25).
+TEST(CollisionChecker, TerrainPitchKeepsTheSeenEndOnItsSupport) {
+  storey::test::World w;
+  w.add(storey::test::aabb({-1.0f, -1, 2.5f}, {0.0f, 1, 2.67f}));  // the tread behind
+  map::TraversabilityMap m;
+  storey::test::scan_world(m, w, {{-2.5f, 0, 4.0f}});
+  CollisionChecker cc(RobotModel{}, m.view().voxel_size_m());
+  const BodyPose p{{0.05, 0, 2.75}, 0.0, std::atan2(0.33, 0.3)};
+  ASSERT_FALSE(m.view().support_surface_near({0.4f, 0, 2.75f}, 0.5).has_value());  // ahead unseen
+  const auto tp = cc.terrain_pitch(m.view(), p);
+  ASSERT_TRUE(tp.has_value());
+  const double half = 0.5 * RobotModel{}.body_length_m;
+  EXPECT_NEAR(*tp, std::atan2(2.75 - 2.67, half), 0.03);
+  const std::vector<BodyPose> poses{p};
+  EXPECT_FALSE(cc.check_poses(m.view(), poses).collides);
+  // A pose pitched less than that bound keeps its own pitch.
+  const BodyPose gentle{{0.05, 0, 2.75}, 0.0, 0.1};
+  EXPECT_FALSE(cc.terrain_pitch(m.view(), gentle).has_value());
+}
+
 TEST(CollisionChecker, NonFinitePoseIsReportedNotSafe) {
   CollisionChecker cc(RobotModel{}, 0.1);
   std::vector<Eigen::Vector3f> vox;
