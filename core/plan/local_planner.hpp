@@ -187,6 +187,10 @@ class LocalPlanner {
   // height (not partial, not dropped on the flight); since construction. The LiDAR never saw
   // that ground: the firmware enters it as support under the legs (firmware/blind_support.hpp).
   uint64_t landings() const { return landings_; }
+  // Diagnostics: foot stands at the end of a partial climb (climbing goes on from there).
+  bool at_partial_climb_end(const Eigen::Vector3d& foot) const {
+    return partial_climb_end(foot) != nullptr;
+  }
   // Diagnostics: the set-aside frontier nodes with their reasons; the entry of the set-aside
   // node nearest p (within set_aside_radius_m), or nullptr.
   const std::vector<SetAsideEntry>& set_aside() const { return set_aside_; }

@@ -639,6 +639,44 @@ TEST(LocalPlanner, AClimbWhoseReferenceTrailsTheClockIsNotDoneAtItsPlannedEnd) {
   }
 }
 
+// A climb that ends higher than planned (it took a tread for its landing: the treads past it
+// unseen, the body's space over it seen free) leaves the robot at the real landing's edge, the
+// walk onto it still to come: recorded as a partial climb ending where the robot stands, so
+// that climbing goes on from there (office seed 3 with graph.close_probes_at_wall_faces, session
+// 25: 0.2 m over the planned end, nothing grew there, "complete"). Here a partial climb up
+// flight_room's flight, its robot reported at the planned end or 0.2 m over it.
+TEST(LocalPlanner, AClimbThatEndsHigherThanPlannedIsAPartialClimbEndingThere) {
+  Harness h;
+  observe_flight_room(h);
+  PlanOptions po;
+  po.climb_blind = true;
+  po.flight_foot = true;
+  const auto view = h.map.view();
+  const std::vector<storey::core::graph::FrontierCluster> at_foot = clusters_at_foot(h);
+  ASSERT_FALSE(at_foot.empty());
+  for (const double above : {0.0, 0.2}) {
+    SCOPED_TRACE(::testing::Message() << "the robot " << above << " m over the planned end");
+    LocalPlanner lp(RobotModel{}, po, 0.1);
+    Eigen::Vector3f foot(-2.0f, 1.2f, 0);
+    double yaw = 0, t = 0;
+    BsplineTrajectory climb;
+    for (int cycle = 0; cycle < 12 && climb.empty(); ++cycle) {
+      const auto r = walked_cycle(lp, h, view, at_foot, foot, yaw, t);
+      if (r && std::string(r->replan_reason).rfind("climb on", 0) == 0) climb = r->trajectory;
+    }
+    ASSERT_FALSE(climb.empty());
+    const BodyPose end = climb.pose(climb.t_end());
+    const Eigen::Vector3d stand = end.foot_m + Eigen::Vector3d(0, 0, above);
+    LocalPlanInput in = input(h, view, stand.cast<float>(), climb.t_end() + 0.5);
+    in.clusters = &at_foot;
+    in.robot_yaw_rad = end.yaw_rad;
+    lp.plan(in);
+    // At the planned end the climb's own end serves; 0.2 m over it (more than a step's
+    // tolerance) only the end recorded where the robot stands.
+    EXPECT_TRUE(lp.at_partial_climb_end(stand)) << stand.transpose();
+  }
+}
+
 // A partial climb (nothing seen past the top tread from below) ends on the top tread. There the
 // body pitches up with the flight: every ray passes over the landing's body space, which is never
 // seen at body height (office seed 1, session 15: no node grew on the landing and the run ended
