@@ -427,11 +427,25 @@ std::optional<LocalPlanResult> walked_cycle(
   return r;
 }
 
+// The blind climb and the climbs from a flight's foot (on in config/default.yaml).
+PlanOptions climbing_options() {
+  PlanOptions po;
+  po.climb_blind = true;
+  po.flight_foot = true;
+  return po;
+}
+
 // flight_room() seen from two places on the floor beside the flight.
 void observe_flight_room(Harness& h) {
   const World w = flight_room();
   h.observe(w, {-2.0f, 1.2f, 0}, 40000, 1);
   h.observe(w, {-1.5f, -1.5f, 0}, 40000, 2);
+}
+
+// flight_room() observed; its frontier clusters at the flight's foot.
+std::vector<storey::core::graph::FrontierCluster> flight_room_at_foot(Harness& h) {
+  observe_flight_room(h);
+  return clusters_at_foot(h);
 }
 
 struct FootRun {
@@ -577,13 +591,9 @@ TEST(LocalPlanner, AFlightsFootIsWalkedToAndClimbedFromAfterItsFrontierWasSeen) 
 // the trajectory's own clock it is still under way.
 TEST(LocalPlanner, AClimbWhoseReferenceTrailsTheClockIsNotDoneAtItsPlannedEnd) {
   Harness h;
-  observe_flight_room(h);
-  PlanOptions po;
-  po.climb_blind = true;
-  po.flight_foot = true;
-  const auto view = h.map.view();
-  const std::vector<storey::core::graph::FrontierCluster> at_foot = clusters_at_foot(h);
+  const auto at_foot = flight_room_at_foot(h);
   ASSERT_FALSE(at_foot.empty());
+  const auto view = h.map.view();
   // lag: the reported lag; past: the clock past the planned end.
   struct Case {
     double lag, past;
@@ -595,7 +605,7 @@ TEST(LocalPlanner, AClimbWhoseReferenceTrailsTheClockIsNotDoneAtItsPlannedEnd) {
                        Case{30.0, LocalPlanner::kMaxReferenceLagS - 1.0, true},
                        Case{30.0, LocalPlanner::kMaxReferenceLagS + 1.0, false}}) {
     SCOPED_TRACE(::testing::Message() << "lag " << c.lag << " s, " << c.past << " s past the end");
-    LocalPlanner lp(RobotModel{}, po, 0.1);
+    LocalPlanner lp(RobotModel{}, climbing_options(), 0.1);
     Eigen::Vector3f foot(-2.0f, 1.2f, 0);
     double yaw = 0, t = 0;
     BsplineTrajectory climb;
@@ -647,16 +657,12 @@ TEST(LocalPlanner, AClimbWhoseReferenceTrailsTheClockIsNotDoneAtItsPlannedEnd) {
 // flight_room's flight, its robot reported at the planned end or 0.2 m over it.
 TEST(LocalPlanner, AClimbThatEndsHigherThanPlannedIsAPartialClimbEndingThere) {
   Harness h;
-  observe_flight_room(h);
-  PlanOptions po;
-  po.climb_blind = true;
-  po.flight_foot = true;
-  const auto view = h.map.view();
-  const std::vector<storey::core::graph::FrontierCluster> at_foot = clusters_at_foot(h);
+  const auto at_foot = flight_room_at_foot(h);
   ASSERT_FALSE(at_foot.empty());
+  const auto view = h.map.view();
   for (const double above : {0.0, 0.2}) {
     SCOPED_TRACE(::testing::Message() << "the robot " << above << " m over the planned end");
-    LocalPlanner lp(RobotModel{}, po, 0.1);
+    LocalPlanner lp(RobotModel{}, climbing_options(), 0.1);
     Eigen::Vector3f foot(-2.0f, 1.2f, 0);
     double yaw = 0, t = 0;
     BsplineTrajectory climb;
@@ -1076,12 +1082,6 @@ storey::core::graph::GraphOptions lead_options() {
 }
 
 // The defaults' climbing switches: blind climbs from a flight's foot.
-PlanOptions climbing_options() {
-  PlanOptions po;
-  po.climb_blind = true;
-  po.flight_foot = true;
-  return po;
-}
 }  // namespace
 
 TEST(LocalPlanner, WithNoFrontierLeftTheRobotClimbsAFlightThatRisesOutOfReach) {
