@@ -186,10 +186,10 @@ std::optional<double> CollisionChecker::terrain_pitch(const map::MapView& view, 
     // top tread onto a landing over the unseen tread between rises 0.33 m in 0.3 m, and at that
     // pose pitch (48 deg) the rear of the body dipped into the tread it stood on (office seed 1
     // with graph.close_probes_at_wall_faces, session 25: the climb onto the landing refused).
-    if (back && p.pitch_rad > std::atan2(p.foot_m.z() - zb, half))
-      return std::atan2(p.foot_m.z() - zb, half);
-    if (front && p.pitch_rad < -std::atan2(p.foot_m.z() - zf, half))
-      return -std::atan2(p.foot_m.z() - zf, half);
+    const double up = std::atan2(p.foot_m.z() - zb, half);     // rear on its support
+    const double down = -std::atan2(p.foot_m.z() - zf, half);  // front on its support
+    if (back && p.pitch_rad > up) return up;
+    if (front && p.pitch_rad < down) return down;
     return std::nullopt;
   }
   if (mid_z) *mid_z = 0.5 * (zf + zb);

@@ -78,7 +78,8 @@ class CollisionChecker {
   // Terrain pitch under a pose: support heights half a body length ahead and behind (nearest
   // to the foot height within the slope window; an end without support is taken at the foot's
   // height if the other end is higher); nullopt if neither end has support, or one has and lies
-  // no higher than the foot.
+  // no higher than the foot (the pose's own pitch stands), unless that pitch would put the seen
+  // end's legs below its support: then the pitch that keeps them on it.
   // `mid_z`: their mean, the height the body's bottom centre rests at on that slope.
   std::optional<double> terrain_pitch(const map::MapView& view, const BodyPose& p,
                                       double* mid_z = nullptr) const;

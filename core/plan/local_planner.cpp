@@ -1200,21 +1200,17 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     climb_done_s_ = in.t_s;
     Eigen::Vector3f end = current_.pose(current_.t_end()).foot_m.cast<float>();
     bool partial = climb_partial_;
-    // With flight_foot, a climb dropped more than a step below its planned end (a collision
-    // predicted once the treads ahead were mapped) climbed up to where the robot stands: a partial
-    // climb ending there. Recorded up to its planned "landing", the flight's frontiers above the
-    // robot were ignored for good (test_stair seed 1: a "landing" mid-flight, dropped on the first
-    // tread, the flight never climbed).
-    if (plan_opt_.flight_foot && in.robot_foot_m.z() < end.z() - robot_.step_height_m) {
-      end = in.robot_foot_m.cast<float>();
-      partial = true;
-    }
-    // A climb that ended higher than planned took a tread for its landing (the treads past it
-    // unseen, the body's space over it seen free): the robot stands at the real landing's edge,
-    // unseen under it, and the walk onto the landing is still to come (office seed 3 with
-    // graph.close_probes_at_wall_faces, session 25: 0.2 m over the planned end, no node grew
-    // there, "complete").
-    if (plan_opt_.flight_foot && in.robot_foot_m.z() > end.z() + 0.75 * robot_.step_height_m) {
+    // With flight_foot, a climb that ended away from its planned height is a partial climb ending
+    // where the robot stands. Dropped more than a step below it (a collision predicted once the
+    // treads ahead were mapped): recorded up to its planned "landing", the flight's frontiers above
+    // the robot were ignored for good (test_stair seed 1: a "landing" mid-flight, dropped on the
+    // first tread, the flight never climbed). More than 0.75 of a step over it: it took a tread
+    // for its landing (the treads past it unseen, the body's space over it seen free), the robot
+    // stands at the real landing's edge and the walk onto it is still to come (office seed 3 with
+    // graph.close_probes_at_wall_faces, session 25: 0.2 m over the end, no node grew, "complete").
+    const double dz_end = in.robot_foot_m.z() - end.z();
+    if (plan_opt_.flight_foot &&
+        (dz_end < -robot_.step_height_m || dz_end > 0.75 * robot_.step_height_m)) {
       end = in.robot_foot_m.cast<float>();
       partial = true;
     }
