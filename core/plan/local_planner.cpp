@@ -222,6 +222,64 @@ bool LocalPlanner::retry_from_elsewhere(const LocalPlanInput& in, LocalPlanResul
   return false;
 }
 
+// Stage 2's candidates for cluster c: its scored viewpoints (at most max_candidates_k), or, on a
+// second visit or with none scored, its representative node facing the centroid.
+std::vector<Viewpoint> LocalPlanner::viewpoints_of(const LocalPlanInput& in,
+                                                   const Candidate& c) const {
+  const graph::ReachableGraph& g = *in.graph;
+  std::vector<Viewpoint> v;
+  for (const auto& cv : *in.viewpoints) {
+    if (cv.cluster_id != c.cluster_id) continue;
+    for (const auto& gv : cv.viewpoints) {
+      if (int(v.size()) >= plan_opt_.max_candidates_k) break;
+      if (gv.node >= g.node_capacity() || !g.node(gv.node).alive) continue;
+      v.push_back({gv.p_m.cast<double>(), double(gv.yaw_rad), gv.node});
+    }
+  }
+  const bool approach =
+      std::find(approached_.begin(), approached_.end(), c.cluster_id) != approached_.end();
+  if (approach) v.clear();  // second visit: onto the frontier node itself
+  if (v.empty()) {          // no scored viewpoint: stand on the representative, facing the centroid
+    const auto& cl = (*in.clusters)[c.cluster_index];
+    const Eigen::Vector3f p = g.node(c.rep).p_m;
+    const Eigen::Vector3f d = cl.centroid_m - p;
+    const double yaw = d.head<2>().norm() > 1e-3f ? std::atan2(d.y(), d.x()) : in.robot_yaw_rad;
+    v.push_back({p.cast<double>(), yaw, c.rep});
+  }
+  return v;
+}
+
+// PlanOptions::reach_off_graph. The last clusters have no path along G_real, but Stage 3 plans
+// on the map (voxel A*): office seed 1 (session 26) ended "complete" in a room whose graph had no
+// edge through its door, frontiers left in the corridor outside. They are tried on the map,
+// nearest first; a cluster no trajectory reaches is set aside (it expires like any other, and
+// path_retries retries it from elsewhere).
+bool LocalPlanner::to_off_graph(const LocalPlanInput& in, std::vector<Candidate>& off,
+                                LocalPlanResult& out) {
+  if (!in.last_resort || !plan_opt_.reach_off_graph || off.empty() || !free_start(in)) return false;
+  const graph::ReachableGraph& g = *in.graph;
+  const Eigen::Vector3f robot = in.robot_foot_m.cast<float>();
+  std::stable_sort(off.begin(), off.end(), [&](const Candidate& a, const Candidate& b) {
+    return (g.node(a.rep).p_m - robot).squaredNorm() < (g.node(b.rep).p_m - robot).squaredNorm();
+  });
+  int attempts = 0;  // bounded work: the rest next cycle
+  for (size_t i = 0; i < off.size() && attempts < opt_.max_stage3_attempts; ++i) {
+    const std::vector<Viewpoint> vps = viewpoints_of(in, off[i]);
+    const graph::FrontierCluster& cluster = (*in.clusters)[off[i].cluster_index];
+    SetAsideReason why = SetAsideReason::kAstarFailed;
+    size_t k = 0;
+    for (; k < vps.size() && attempts < opt_.max_stage3_attempts; ++k, ++attempts) {
+      if (!try_target(in, vps[k], out, &why)) continue;
+      adopt_target(in, cluster, out);
+      out.replan_reason =
+          "off the graph: no path along G_real to the last frontiers, one on the map";
+      return true;
+    }
+    if (k == vps.size()) set_aside_cluster(in, cluster, why, last_hit_m_);  // every one tried
+  }
+  return false;
+}
+
 void LocalPlanner::adopt_target(const LocalPlanInput& in, const graph::FrontierCluster& c,
                                 LocalPlanResult& out) {
   // PlanOptions::replan_only_if_faster: a periodic replan to the same cluster whose trajectory
@@ -987,11 +1045,22 @@ bool LocalPlanner::try_target(const LocalPlanInput& in, const Viewpoint& vp, Loc
     if (tr.hit.collides) last_hit_m_ = tr.hit.voxel_m.cast<float>();
     return tr.status != TrajectoryStatus::kOk && tr.status != TrajectoryStatus::kPolyline;
   };
-  if (failed()) {
+  // PlanOptions::arrive_along_path: the body hit something within a body length of the
+  // viewpoint, turning to its heading: arrive facing along the path (the curve's own end yaw).
+  auto along_path = [&]() {
+    if (!plan_opt_.arrive_along_path || !tr.hit.collides ||
+        (tr.hit.voxel_m - vp.p_m).head<2>().norm() > robot_.body_length_m)
+      return false;
+    tr = builder_.build(*in.view, checker_, path.points_m, start_yaw_, std::nullopt, in.t_s);
+    if (failed()) return false;
+    goal_yaw = tr.trajectory.pose(tr.trajectory.t_end()).yaw_rad;
+    return true;
+  };
+  if (failed() && !along_path()) {
     if (on_graph || !graph_path()) return false;
     goal_yaw = shape_path(*in.view, path.points_m, vp.yaw_rad);
     tr = builder_.build(*in.view, checker_, path.points_m, start_yaw_, goal_yaw, in.t_s);
-    if (failed()) return false;
+    if (failed() && !along_path()) return false;
   }
   out.trajectory = std::move(tr.trajectory);
   out.path_m = std::move(path.points_m);
@@ -1331,7 +1400,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
       start_nodes_m_.push_back(g.node(by_d[k].second).p_m.cast<double>());
   }
   search_.dijkstra(sg_, std::span<const uint32_t>(&robot_node, 1));
-  std::vector<Candidate> cands;
+  std::vector<Candidate> cands, off_graph;  // off_graph: no path along G_real
   std::vector<double> cand_dist;
   for (size_t ci = 0; ci < in.clusters->size(); ++ci) {
     const graph::FrontierCluster& c = (*in.clusters)[ci];
@@ -1351,6 +1420,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     const double d = search_.dist(rep);
     if (!std::isfinite(d)) {
       ++out.clusters_unreachable;
+      off_graph.push_back({c.id, ci, rep});
       continue;
     }
     cands.push_back({c.id, ci, rep});
@@ -1361,6 +1431,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
       return commit_climb("climb on: no reachable frontier, standing on a flight");
     if (climb_last())
       return to_climb("climb on: no reachable frontier, up the flight left for last");
+    if (to_off_graph(in, off_graph, out)) return out;
     if (retry_from_elsewhere(in, out)) return out;
     if (to_flight_lead(in, out)) return out;
     out.status = LocalPlanStatus::kNoReachableTarget;
@@ -1405,31 +1476,9 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
 
   // ---- Stage 2: one viewpoint per cluster over the window W (Eq. 6).
   probe_mark(probe_, PlanStage::kLocalStage2);
-  auto viewpoints_of = [&](const Candidate& c) {
-    std::vector<Viewpoint> v;
-    for (const auto& cv : *in.viewpoints) {
-      if (cv.cluster_id != c.cluster_id) continue;
-      for (const auto& gv : cv.viewpoints) {
-        if (int(v.size()) >= plan_opt_.max_candidates_k) break;
-        if (gv.node >= g.node_capacity() || !g.node(gv.node).alive) continue;
-        v.push_back({gv.p_m.cast<double>(), double(gv.yaw_rad), gv.node});
-      }
-    }
-    const bool approach =
-        std::find(approached_.begin(), approached_.end(), c.cluster_id) != approached_.end();
-    if (approach) v.clear();  // second visit: onto the frontier node itself
-    if (v.empty()) {  // no scored viewpoint: stand on the representative, facing the centroid
-      const auto& cl = (*in.clusters)[c.cluster_index];
-      const Eigen::Vector3f p = g.node(c.rep).p_m;
-      const Eigen::Vector3f d = cl.centroid_m - p;
-      const double yaw = d.head<2>().norm() > 1e-3f ? std::atan2(d.y(), d.x()) : in.robot_yaw_rad;
-      v.push_back({p.cast<double>(), yaw, c.rep});
-    }
-    return v;
-  };
   const size_t w = std::min(order.size(), size_t(std::max(1, plan_opt_.window_w)));
   std::vector<std::vector<Viewpoint>> window;
-  for (size_t m = 0; m < w; ++m) window.push_back(viewpoints_of(sel[order[m]]));
+  for (size_t m = 0; m < w; ++m) window.push_back(viewpoints_of(in, sel[order[m]]));
   std::map<std::pair<uint32_t, uint32_t>, double> memo;
   const ViewpointDistance d = [&](const Viewpoint& a, const Viewpoint& b) {
     if (a.node == b.node) return (a.p_m - b.p_m).norm();
@@ -1463,7 +1512,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   std::vector<Failed> failed;
   for (size_t m = 0; m < order.size() && attempts < opt_.max_stage3_attempts; ++m) {
     const Candidate& c = sel[order[m]];
-    std::vector<Viewpoint> vps = m < window.size() ? window[m] : viewpoints_of(c);
+    std::vector<Viewpoint> vps = m < window.size() ? window[m] : viewpoints_of(in, c);
     if (m == 0 && dp.status == DpStatus::kOk && !dp.choice.empty())
       std::rotate(vps.begin(), vps.begin() + dp.choice[0], vps.begin() + dp.choice[0] + 1);
     bool ok = false;

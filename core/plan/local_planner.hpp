@@ -223,6 +223,9 @@ class LocalPlanner {
   void set_aside_cluster(const LocalPlanInput& in, const graph::FrontierCluster& c,
                          SetAsideReason reason, const Eigen::Vector3f& hit_m = kNoHitM);
   int expire_set_aside(const LocalPlanInput& in);
+  std::vector<Viewpoint> viewpoints_of(const LocalPlanInput& in, const Candidate& c) const;
+  // PlanOptions::reach_off_graph: clusters without a path along G_real tried on the map.
+  bool to_off_graph(const LocalPlanInput& in, std::vector<Candidate>& off, LocalPlanResult& out);
   // Nothing else left: move to a new vantage point before the path failures end the run.
   bool retry_from_elsewhere(const LocalPlanInput& in, LocalPlanResult& out);
   void release_retry();

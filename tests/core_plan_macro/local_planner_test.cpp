@@ -1306,3 +1306,139 @@ TEST(LocalPlanner, FromTheLandingOfAUShapedStairTheRobotGoesToItsReturnFlight) {
   EXPECT_NEAR(next->target_m.z(), 1.512, 0.05);
   EXPECT_NEAR(std::abs(next->target_yaw_rad), M_PI, 0.2);
 }
+
+// PlanOptions::reach_off_graph. A 2 m corridor whose graph grew over its length, then narrowed
+// to a 0.8 m opening at x = 5: the graph is cut there (GraphOptions::keep_reachable_cut keeps the
+// far part, expansion slowed to one node per update does not re-link it), so the frontier at the
+// far end has no path along G_real from the robot (the office, seed 1, session 26: a room whose
+// graph had no edge through its door). The map still has a way through the opening for the
+// 0.41 m wide body. Off: no reachable target. On: Stage 3 on the map takes the robot through.
+namespace {
+World long_corridor() {
+  World w;
+  w.add({-3, -1, -0.2f}, {30, 1, 0});
+  w.add({-3, -1.2f, 0}, {30, -1, 2.5f});
+  w.add({-3, 1, 0}, {30, 1.2f, 2.5f});
+  w.add({-3.2f, -1.2f, 0}, {-3, 1.2f, 2.5f});
+  return w;
+}
+
+struct OffGraphRun {
+  LocalPlanStatus status = LocalPlanStatus::kBadInput;
+  std::string reason;
+  int unreachable = 0;
+  double end_x_m = 0;  // the trajectory's end
+  double max_x_m = 0;  // the farthest frontier node
+};
+
+OffGraphRun run_off_graph(bool on) {
+  storey::core::graph::GraphOptions go;
+  go.keep_reachable_cut = true;
+  go.max_expansions_per_update = 1;
+  Harness h(go, 3);
+  World w = long_corridor();
+  for (float x : {0.f, 3.f, 7.f, 10.f})
+    h.observe(w, Eigen::Vector3f(x, 0, 0), 100000, 11 + uint32_t(x));
+  w.add({5.0f, -1.0f, 0.0f}, {5.2f, -0.4f, 2.5f});
+  w.add({5.0f, 0.4f, 0.0f}, {5.2f, 1.0f, 2.5f});
+  const Eigen::Vector3f foot(3.5f, 0, 0);
+  for (uint32_t r = 0; r < 3; ++r) h.observe(w, foot, 100000, 40 + r);
+  PlanOptions po;
+  po.reach_off_graph = on;
+  LocalPlanner lp(RobotModel{}, po, 0.1);
+  const auto view = h.map.view();
+  std::vector<storey::core::graph::FrontierCluster> far;  // beyond the cut
+  for (const auto& c : h.clusters.clusters())
+    if (c.centroid_m.x() > 5.3f) far.push_back(c);
+  LocalPlanInput in = input(h, view, foot, 0.0);
+  in.clusters = &far;
+  in.last_resort = true;
+  const LocalPlanResult r = lp.plan(in);
+  OffGraphRun run;
+  run.status = r.status;
+  run.reason = r.replan_reason;
+  run.unreachable = r.clusters_unreachable;
+  if (r.status == LocalPlanStatus::kNewTrajectory)
+    run.end_x_m = r.trajectory.pose(r.trajectory.t_end()).foot_m.x();
+  for (const auto& c : far)
+    for (auto n : c.nodes) run.max_x_m = std::max(run.max_x_m, double(h.graph.node(n).p_m.x()));
+  return run;
+}
+}  // namespace
+
+TEST(LocalPlanner, FrontiersWithNoPathAlongTheGraphAreReachedOnTheMapWithReachOffGraph) {
+  const OffGraphRun off = run_off_graph(false);
+  ASSERT_GT(off.max_x_m, 12.0);  // the far end's frontier, beyond the cut
+  ASSERT_GT(off.unreachable, 0);
+  EXPECT_EQ(off.status, LocalPlanStatus::kNoReachableTarget);
+  const OffGraphRun on = run_off_graph(true);
+  EXPECT_EQ(on.unreachable, off.unreachable);
+  ASSERT_EQ(on.status, LocalPlanStatus::kNewTrajectory);
+  EXPECT_EQ(on.reason.rfind("off the graph", 0), 0u) << on.reason;
+  EXPECT_GT(on.end_x_m, 5.5);  // through the opening
+}
+
+// PlanOptions::arrive_along_path. A 2 m corridor with a gate 0.7 m wide and 0.6 m long 3 m
+// ahead: the 0.8 m body box (0.7 m and its margins) walks through it but cannot stand across it.
+// A viewpoint in the gate facing across the corridor (as one beside a ramp's edge faced a
+// frontier behind the robot on test_ramp, session 26): off, every trajectory to it collides where
+// it turns and the cluster fails Stage 3; on, the robot arrives there facing along the corridor.
+namespace {
+struct ArriveRun {
+  LocalPlanStatus status = LocalPlanStatus::kBadInput;
+  Eigen::Vector3d end_m = Eigen::Vector3d::Zero();
+  double end_yaw_rad = 0;
+};
+
+ArriveRun run_arrive(bool on) {
+  World w = long_corridor();
+  w.add({2.7f, -1.0f, 0.0f}, {3.3f, -0.35f, 2.5f});
+  w.add({2.7f, 0.35f, 0.0f}, {3.3f, 1.0f, 2.5f});
+  Harness h;
+  const Eigen::Vector3f foot(0, 0, 0);
+  h.observe(w, foot, 100000, 5);
+  // The easternmost cluster (the graph stops at the gate), with one viewpoint: in the gate,
+  // facing across.
+  std::vector<storey::core::graph::FrontierCluster> east;
+  for (const auto& c : h.clusters.clusters())
+    if (east.empty() || c.centroid_m.x() > east[0].centroid_m.x()) east.assign(1, c);
+  ArriveRun run;
+  const auto node = h.graph.nearest(Eigen::Vector3f(3, 0, 0), 1.5f, 0.5f);
+  EXPECT_FALSE(east.empty());
+  EXPECT_NE(node, storey::core::graph::kNoId);
+  if (east.empty() || node == storey::core::graph::kNoId) return run;
+  storey::core::graph::ClusterViewpoints cv;
+  cv.cluster_id = east[0].id;
+  storey::core::graph::Viewpoint v;
+  v.node = node;
+  v.p_m = Eigen::Vector3f(3, 0, 0);
+  v.yaw_rad = float(M_PI / 2);
+  v.visible = 1;
+  cv.viewpoints.push_back(v);
+  const std::vector<storey::core::graph::ClusterViewpoints> vps{cv};
+  PlanOptions po;
+  po.arrive_along_path = on;
+  LocalPlanner lp(RobotModel{}, po, 0.1);
+  const auto view = h.map.view();
+  LocalPlanInput in = input(h, view, foot, 0.0);
+  in.clusters = &east;
+  in.viewpoints = &vps;
+  const LocalPlanResult r = lp.plan(in);
+  run.status = r.status;
+  if (r.status == LocalPlanStatus::kNewTrajectory) {
+    const auto end = r.trajectory.pose(r.trajectory.t_end());
+    run.end_m = end.foot_m;
+    run.end_yaw_rad = end.yaw_rad;
+  }
+  return run;
+}
+}  // namespace
+
+TEST(LocalPlanner, AViewpointTheBodyCannotTurnToIsReachedFacingAlongThePathWithArriveAlongPath) {
+  const ArriveRun off = run_arrive(false);
+  EXPECT_EQ(off.status, LocalPlanStatus::kNoReachableTarget);
+  const ArriveRun on = run_arrive(true);
+  ASSERT_EQ(on.status, LocalPlanStatus::kNewTrajectory);
+  EXPECT_LT((on.end_m - Eigen::Vector3d(3, 0, 0)).head<2>().norm(), 0.3);
+  EXPECT_LT(std::abs(std::remainder(on.end_yaw_rad, 2 * M_PI)), 0.35);  // along the corridor
+}
