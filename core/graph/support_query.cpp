@@ -208,7 +208,7 @@ SupportQuery::ProbeSegment SupportQuery::probe_segment(const Eigen::Vector3f& fr
         // that no view resolves.
         if (*unknown_run == 0 && opt_.close_probes_at_holes &&
             (hole_in_surface(k) || hole_in_surface(before))) {
-          r.closed = true;
+          r.closed = r.hole = true;
           return false;
         }
         ++*unknown_run;
@@ -258,9 +258,11 @@ bool SupportQuery::wall_face(const Support& top, const Eigen::Vector2f& dir) {
 
 bool SupportQuery::probe_open_climbing(const Eigen::Vector3f& foot, const Eigen::Vector2f& dir,
                                        float length_m, float height_m, float min_free_m,
-                                       float min_unknown_m, bool* climbed, bool* leaves_reach) {
+                                       float min_unknown_m, bool* climbed, bool* leaves_reach,
+                                       bool* blocked) {
   constexpr int kMaxClimbs = 24;
   if (climbed) *climbed = false;
+  if (blocked) *blocked = false;
   if (leaves_reach) *leaves_reach = false;
   // Horizontal probe: |dx| + |dy| voxels per metre (6-connected walk).
   const float per_m = (std::abs(dir.x()) + std::abs(dir.y())) * inv_vs_;
@@ -278,6 +280,7 @@ bool SupportQuery::probe_open_climbing(const Eigen::Vector3f& foot, const Eigen:
     const Eigen::Vector3f from(foot.x() + dir.x() * s0, foot.y() + dir.y() * s0, zc + height_m);
     const Eigen::Vector3f to(foot.x() + dir.x() * s_end, foot.y() + dir.y() * s_end, zc + height_m);
     const ProbeSegment seg = probe_segment(from, to, need_free, &free_total, &unknown_run);
+    if (blocked) *blocked = seg.hole;
     if (seg.closed) return false;
     if (!seg.hit) return unknown_run >= need_unknown;
     const VoxelKey& hit = seg.hit_key;
@@ -309,6 +312,7 @@ bool SupportQuery::probe_open_climbing(const Eigen::Vector3f& foot, const Eigen:
       if (o == Occupancy::kUnknown) return free_total >= need_free;
       if (o == Occupancy::kFree) break;
     }
+    if (blocked) *blocked = true;
     return false;
   }
   return false;

@@ -101,9 +101,12 @@ class SupportQuery {
   // III-C: stairs are the way to the next floor). `climbed` (optional) tells whether an open
   // probe had climbed two stair steps (each steeper than 25 deg) first: it runs up a flight.
   // *leaves_reach: the probe climbed a flight (two stair steps) onto support out of C_reach.
+  // *blocked: a closed probe ended at an obstacle it could not climb or at a hole in a surface
+  // (close_probes_at_holes): a wall.
   bool probe_open_climbing(const Eigen::Vector3f& foot, const Eigen::Vector2f& dir, float length_m,
                            float height_m, float min_free_m, float min_unknown_m,
-                           bool* climbed = nullptr, bool* leaves_reach = nullptr);
+                           bool* climbed = nullptr, bool* leaves_reach = nullptr,
+                           bool* blocked = nullptr);
 
   const map::MapView& view() const { return view_; }
   float voxel_size() const { return vs_; }
@@ -115,6 +118,7 @@ class SupportQuery {
   // need_free free voxels (closed).
   struct ProbeSegment {
     bool hit = false, closed = false;
+    bool hole = false;  // closed at a hole in a surface (close_probes_at_holes): a wall
     map::VoxelKey hit_key{};
   };
   ProbeSegment probe_segment(const Eigen::Vector3f& from, const Eigen::Vector3f& to, int need_free,

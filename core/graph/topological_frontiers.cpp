@@ -57,7 +57,8 @@ float TopologicalFrontiers::missing_surface_ratio(SupportQuery& q, const GraphNo
 // probe_unknown_m of it) without hitting an obstacle first. *up counts the open probes that
 // climbed first.
 int TopologicalFrontiers::open_directions(SupportQuery& q, const ReachableGraph& g, NodeId i,
-                                          int* up, int* leads) {
+                                          int* up, int* leads, int* passages) {
+  enum : uint8_t { kOther = 0, kOpen, kBlocked };
   const GraphNode& n = g.node(i);
   const int probes = std::max(1, opt_.probes);
   const float half = float(opt_.alpha_min_rad) * 0.5f;
@@ -65,6 +66,7 @@ int TopologicalFrontiers::open_directions(SupportQuery& q, const ReachableGraph&
   int open = 0;
   *up = 0;
   if (leads) *leads = 0;
+  probe_state_.assign(size_t(probes), kOther);
   for (int k = 0; k < probes; ++k) {
     const float th = 2.0f * float(M_PI) * float(k) / float(probes);
     bool covered = false;
@@ -75,14 +77,24 @@ int TopologicalFrontiers::open_directions(SupportQuery& q, const ReachableGraph&
       covered = std::abs(diff) < half;
     }
     if (covered) continue;
-    bool climbed = false, out_of_reach = false;
+    bool climbed = false, out_of_reach = false, blocked = false;
     const bool o = q.probe_open_climbing(n.p_m, Eigen::Vector2f(std::cos(th), std::sin(th)),
                                          float(opt_.probe_length_m), float(opt_.probe_height_m),
                                          min_free, float(opt_.probe_unknown_m), &climbed,
-                                         leads ? &out_of_reach : nullptr);
+                                         leads ? &out_of_reach : nullptr, &blocked);
+    probe_state_[size_t(k)] = o ? kOpen : blocked ? kBlocked : kOther;
     open += o;
     *up += o && climbed;
     if (leads) *leads += out_of_reach;
+  }
+  if (passages) {  // an open probe, its neighbours closed, one of them by an obstacle
+    *passages = 0;
+    for (int k = 0; k < probes && probes >= 3; ++k) {
+      const uint8_t a = probe_state_[size_t((k + probes - 1) % probes)];
+      const uint8_t b = probe_state_[size_t((k + 1) % probes)];
+      *passages += probe_state_[size_t(k)] == kOpen && a != kOpen && b != kOpen &&
+                   (a == kBlocked || b == kBlocked);
+    }
   }
   return open;
 }
@@ -142,13 +154,15 @@ void TopologicalFrontiers::evaluate_flags(ReachableGraph& g, SupportQuery& q, No
     n.c_sur = omega * 4 >= std::max(1, opt_.surface_samples) && n.rho >= float(opt_.rho_min);
   }
   if (opt_.use_c_exp) {
-    int up = 0, leads = 0;
-    const int open = open_directions(q, g, i, &up, opt_.climb_frontiers ? &leads : nullptr);
+    int up = 0, leads = 0, passages = 0;
+    const int open = open_directions(q, g, i, &up, opt_.climb_frontiers ? &leads : nullptr,
+                                     opt_.passage_frontiers ? &passages : nullptr);
     n.open_dirs = uint8_t(std::min(open, 255));
     n.flight_lead = leads > 0;
     // A flight of stairs is one probe wide: its walls close the probes beside it.
     // One probe that climbs it into unknown space is the way to the next floor (Sec. III-C).
-    n.c_exp = open >= opt_.theta_min || (opt_.climb_frontiers && up >= 1);
+    n.c_exp = open >= opt_.theta_min || (opt_.climb_frontiers && up >= 1) ||
+              (opt_.passage_frontiers && passages >= 1);
   }
 }
 

@@ -53,8 +53,10 @@ class TopologicalFrontiers {
 
  private:
   float missing_surface_ratio(SupportQuery& q, const GraphNode& n, int* samples);  // Eq. 5
+  // *passages (optional): open probes whose two neighbours are closed, one of them by an
+  // obstacle (GraphOptions::passage_frontiers).
   int open_directions(SupportQuery& q, const ReachableGraph& g, NodeId i, int* up,
-                      int* leads = nullptr);
+                      int* leads = nullptr, int* passages = nullptr);
   bool near_reach_boundary(SupportQuery& q, const GraphNode& n);
   void evaluate(ReachableGraph& g, SupportQuery& q, NodeId i);
   void evaluate_flags(ReachableGraph& g, SupportQuery& q, NodeId i);
@@ -65,6 +67,7 @@ class TopologicalFrontiers {
   std::vector<uint8_t> queued_;
   std::vector<NodeId> scratch_;
   std::vector<uint8_t> cls_;
+  std::vector<uint8_t> probe_state_;  // open_directions: per probe (scratch)
   std::vector<Aabb> boxes_, opened_;
 };
 

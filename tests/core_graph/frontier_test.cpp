@@ -511,3 +511,41 @@ TEST(TopologicalFrontiers, AFlightRisingOutOfTheReachableSetIsAFlightLead) {
     EXPECT_EQ(far, 0);
   }
 }
+
+// GraphOptions::passage_frontiers. A 1 m corridor seen to 3 m from its closed end: at the graph's
+// end one probe runs on along it into unknown space; the probes 30 deg either side meet its walls
+// (or, one of them, start in air the scan left unknown).
+// One open probe is below Theta_min = 2 (with close_probes_at_wall_faces no phantom step adds a
+// second: test_ramp's upper corridors, session 26). With the switch that probe, between two
+// blocked by walls, is a passage: C_exp.
+TEST(TopologicalFrontiers, ACorridorsEndIsAnExpansionFrontierWithPassageFrontiers) {
+  World w;
+  w.add({-1.2f, -0.7f, -0.3f}, {20, 0.7f, 0.0f});
+  w.add({-1.2f, -0.7f, 0.0f}, {20, -0.5f, 2.5f});
+  w.add({-1.2f, 0.5f, 0.0f}, {20, 0.7f, 2.5f});
+  w.add({-1.2f, -0.5f, 0.0f}, {-1.0f, 0.5f, 2.5f});
+  for (const bool on : {false, true}) {
+    SCOPED_TRACE(on ? "graph.passage_frontiers on" : "off");
+    GraphOptions o;
+    o.close_probes_at_holes = o.close_probes_at_wall_faces = true;  // as in config/default.yaml
+    o.passage_frontiers = on;
+    Harness h(o);
+    h.observe(w, Vector3f(0, 0, 0.55f), Vector3f(0, 0, 0), 100000, 7, 3.0f);
+    int passages = 0, others = 0;  // C_exp nodes with one open probe / more
+    float max_x = -1;
+    for (NodeId i = 0; i < h.graph.node_capacity(); ++i) {
+      const GraphNode& n = h.graph.node(i);
+      if (!n.alive) continue;
+      max_x = std::max(max_x, n.p_m.x());
+      if (!n.c_exp) continue;
+      (n.open_dirs == 1 ? passages : others) += 1;
+      EXPECT_GT(n.p_m.x(), 0.5f);  // the open end, not the closed one
+    }
+    ASSERT_GT(max_x, 0.5f);  // the graph reached along the corridor
+    EXPECT_EQ(others, 0);
+    if (on)
+      EXPECT_GE(passages, 1);
+    else
+      EXPECT_EQ(passages, 0);
+  }
+}
