@@ -61,14 +61,15 @@ struct PlanOptions {
   // where it stood) are retried up to this many times, each after a move to a new vantage point. 0:
   // off.
   int path_retries = 0;
-  // Beyond the paper (session 26): a viewpoint whose heading the body cannot turn to where it
-  // stands (a collision within a body length of it: on a 1.5 m ramp, test_ramp) is reached
-  // facing along the path instead. The heading is a preference (Eq. 6 prices the turn); the LiDAR
-  // sees all round, so the frontier is observed from the viewpoint either way.
+  // Beyond the paper, on in config/default.yaml (session 26): a viewpoint whose heading the body
+  // cannot turn to where it stands (a collision within a body length of it: on a 1.5 m ramp,
+  // test_ramp) is reached facing along the path instead. The heading is a preference (Eq. 6 prices
+  // the turn); the LiDAR sees all round, so the frontier is observed from the viewpoint either way.
   bool arrive_along_path = false;
-  // Beyond the paper (session 26): before "complete", clusters with no path along G_real are tried
-  // with Stage 3 on the map (voxel A*), which needs no graph (a graph split at a door it did not
-  // link through: office seed 1). One that no trajectory reaches is set aside.
+  // Beyond the paper, on in config/default.yaml (session 26): before "complete", clusters with no
+  // path along G_real are tried with Stage 3 on the map (voxel A*), which needs no graph (a graph
+  // split at a door it did not link through: office seed 1). One that no trajectory reaches is set
+  // aside.
   bool reach_off_graph = false;
   // Beyond the paper, off (session 13): at a frontier the blind climb also looks for the flight
   // from up to this far ahead on level ground (flight_axis needs treads 0.6 and 0.9 m ahead; a

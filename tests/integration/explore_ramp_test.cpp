@@ -15,7 +15,8 @@ TEST(ExploreRamp, ReachesAndExploresTheUpperFloorSafely) {
   EXPECT_EQ(m.falls, 0u);
   ASSERT_EQ(m.floors_total, 2);
   ASSERT_EQ(m.per_floor.size(), 2u);
-  // Measured 0.914 / 0.942, complete at 275.0 s (seed 1, session 22; seeds 2-3: upper floor 0.916 /
+  // Measured 0.938 / 0.899, complete at 431.5 s (seed 1, session 26, plan.arrive_along_path and
+  // reach_off_graph on). Session 22: 0.914 / 0.942 at 275.0 s (seeds 2-3: upper floor 0.916 /
   // 0.947). Session 18: 0.918 / 0.945 at 515.5 s (seeds 2-4: upper floor 0.921 / 0.863 / 0.945).
   // Session 12: 0.938 / 0.730 at 596.5 s (seeds 2-4: 0.929 / 0.935 / 0.944; docs/RESULTS.md).
   // Session 11: 0.845 / 0.930 (0.916 / 0.916 with the session 9-11 switches off). Earlier: 0.893 /
