@@ -1141,6 +1141,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   probe_mark(probe_, PlanStage::kLocalKeep);
   const char* reason = stuck ? "no progress" : "no target";
   int32_t kept_cluster = -1;  // the target's cluster at a periodic replan (target momentum)
+  bool still_free = false;    // ... whose trajectory is still free (keep_on_failed_replan)
   if (has_target_) {
     const graph::FrontierCluster* tc = track_target(in);
     const double dxy = (in.robot_foot_m - target_m_).head<2>().norm();
@@ -1234,6 +1235,8 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
         has_target_ = false;
         kept_cluster = tc ? tc->id : -1;
         periodic_ = plan_opt_.replan_only_if_faster && tc;
+        still_free =
+            plan_opt_.keep_on_failed_replan && tc && !climb_start_ && !retrying_ && !climbing_;
       } else {
         out.status = LocalPlanStatus::kKeep;
         flight_target_ = flight_target;
@@ -1525,6 +1528,22 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
       return out;
     }
     failed.push_back({m, why, last_hit_m_});
+  }
+  // Every attempt failed at a periodic replan: the trajectory followed was checked free on this
+  // map above, so it stays (PlanOptions::keep_on_failed_replan; maze seed 1, session 26: each such
+  // replan in a narrow passage escaped, and the cluster beyond it was never reached).
+  if (!failed.empty() && still_free) {
+    has_target_ = true;
+    next_flight_ = next_flight;
+    planned_at_s_ = in.t_s;
+    out.status = LocalPlanStatus::kKeep;
+    out.replan_reason = "periodic replan found no trajectory: the one followed is still free";
+    out.trajectory = BsplineTrajectory{};
+    out.path_m.clear();
+    out.target_cluster = target_cluster_;
+    out.target_m = target_m_;
+    out.real_until_s = current_.t_end();
+    return out;
   }
   // Every attempt failed. If the robot cannot turn where it stands (a dead end narrower than
   // the body's turning circle: every path back starts with a turn), the clusters are not to

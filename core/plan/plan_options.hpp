@@ -71,6 +71,12 @@ struct PlanOptions {
   // split at a door it did not link through: office seed 1). One that no trajectory reaches is set
   // aside.
   bool reach_off_graph = false;
+  // Beyond the paper, off (session 27): a periodic replan in which Stage 3 finds no trajectory to
+  // any cluster keeps the trajectory followed, still collision-free on this cycle's map, instead of
+  // an escape. From a pose on a walk through a narrow passage a new B-spline (from rest, at the
+  // robot's heading) may find no room to turn that the walk itself never needed: maze seed 1
+  // (session 26) escaped at the same corner eight times and never reached the cluster beyond it.
+  bool keep_on_failed_replan = false;
   // Beyond the paper, off (session 13): at a frontier the blind climb also looks for the flight
   // from up to this far ahead on level ground (flight_axis needs treads 0.6 and 0.9 m ahead; a
   // viewpoint 0.83 m before the first riser ended the office, seed 2, unclimbed). 0: from the

@@ -1384,6 +1384,37 @@ TEST(LocalPlanner, FrontiersWithNoPathAlongTheGraphAreReachedOnTheMapWithReachOf
 // frontier behind the robot on test_ramp, session 26): off, every trajectory to it collides where
 // it turns and the cluster fails Stage 3; on, the robot arrives there facing along the corridor.
 namespace {
+// The corridor with the gate, scanned from the origin: the easternmost cluster (the graph stops
+// at the gate) and a viewpoint of it at `at` (on the graph node nearest it) facing `yaw`.
+struct GateScene {
+  Harness h;
+  std::vector<storey::core::graph::FrontierCluster> east;
+  GateScene() {
+    World w = long_corridor();
+    w.add({2.7f, -1.0f, 0.0f}, {3.3f, -0.35f, 2.5f});
+    w.add({2.7f, 0.35f, 0.0f}, {3.3f, 1.0f, 2.5f});
+    h.observe(w, Eigen::Vector3f(0, 0, 0), 100000, 5);
+    for (const auto& c : h.clusters.clusters())
+      if (east.empty() || c.centroid_m.x() > east[0].centroid_m.x()) east.assign(1, c);
+    EXPECT_FALSE(east.empty());
+  }
+  std::vector<storey::core::graph::ClusterViewpoints> viewpoint(const Eigen::Vector3f& at,
+                                                                double yaw) const {
+    const auto node = h.graph.nearest(at, 1.5f, 0.5f);
+    EXPECT_NE(node, storey::core::graph::kNoId);
+    if (east.empty() || node == storey::core::graph::kNoId) return {};
+    storey::core::graph::ClusterViewpoints cv;
+    cv.cluster_id = east[0].id;
+    storey::core::graph::Viewpoint v;
+    v.node = node;
+    v.p_m = at;
+    v.yaw_rad = float(yaw);
+    v.visible = 1;
+    cv.viewpoints.push_back(v);
+    return {cv};
+  }
+};
+
 struct ArriveRun {
   LocalPlanStatus status = LocalPlanStatus::kBadInput;
   Eigen::Vector3d end_m = Eigen::Vector3d::Zero();
@@ -1391,36 +1422,17 @@ struct ArriveRun {
 };
 
 ArriveRun run_arrive(bool on) {
-  World w = long_corridor();
-  w.add({2.7f, -1.0f, 0.0f}, {3.3f, -0.35f, 2.5f});
-  w.add({2.7f, 0.35f, 0.0f}, {3.3f, 1.0f, 2.5f});
-  Harness h;
-  const Eigen::Vector3f foot(0, 0, 0);
-  h.observe(w, foot, 100000, 5);
-  // The easternmost cluster (the graph stops at the gate), with one viewpoint: in the gate,
-  // facing across.
-  std::vector<storey::core::graph::FrontierCluster> east;
-  for (const auto& c : h.clusters.clusters())
-    if (east.empty() || c.centroid_m.x() > east[0].centroid_m.x()) east.assign(1, c);
+  const GateScene s;
+  // One viewpoint: in the gate, facing across.
+  const auto vps = s.viewpoint(Eigen::Vector3f(3, 0, 0), M_PI / 2);
   ArriveRun run;
-  const auto node = h.graph.nearest(Eigen::Vector3f(3, 0, 0), 1.5f, 0.5f);
-  EXPECT_FALSE(east.empty());
-  EXPECT_NE(node, storey::core::graph::kNoId);
-  if (east.empty() || node == storey::core::graph::kNoId) return run;
-  storey::core::graph::ClusterViewpoints cv;
-  cv.cluster_id = east[0].id;
-  storey::core::graph::Viewpoint v;
-  v.node = node;
-  v.p_m = Eigen::Vector3f(3, 0, 0);
-  v.yaw_rad = float(M_PI / 2);
-  v.visible = 1;
-  cv.viewpoints.push_back(v);
-  const std::vector<storey::core::graph::ClusterViewpoints> vps{cv};
+  if (vps.empty()) return run;
   PlanOptions po;
   po.arrive_along_path = on;
   LocalPlanner lp(RobotModel{}, po, 0.1);
-  const auto view = h.map.view();
-  LocalPlanInput in = input(h, view, foot, 0.0);
+  const auto view = s.h.map.view();
+  LocalPlanInput in = input(s.h, view, Eigen::Vector3f(0, 0, 0), 0.0);
+  std::vector<storey::core::graph::FrontierCluster> east = s.east;
   in.clusters = &east;
   in.viewpoints = &vps;
   const LocalPlanResult r = lp.plan(in);
@@ -1432,7 +1444,44 @@ ArriveRun run_arrive(bool on) {
   }
   return run;
 }
+
+// PlanOptions::keep_on_failed_replan. The robot walks toward a viewpoint 2.2 m down the
+// corridor; at the periodic replan (it has not moved: held up) the cluster's only viewpoint is
+// one in the gate facing across, which no trajectory reaches (as a replan from a corner of the
+// maze found no room to turn, session 26). The trajectory followed is still free: on, it stays;
+// off, the replan ends in something else (an escape, or no reachable target).
+LocalPlanResult failed_replan(bool on) {
+  const GateScene s;
+  const auto reachable = s.viewpoint(Eigen::Vector3f(2.2f, 0, 0), 0.0);
+  const auto across = s.viewpoint(Eigen::Vector3f(3, 0, 0), M_PI / 2);
+  if (reachable.empty() || across.empty()) return {};
+  PlanOptions po;
+  po.keep_on_failed_replan = on;
+  LocalPlanner lp(RobotModel{}, po, 0.1);
+  const auto view = s.h.map.view();
+  LocalPlanInput in = input(s.h, view, Eigen::Vector3f(0, 0, 0), 0.0);
+  std::vector<storey::core::graph::FrontierCluster> east = s.east;
+  in.clusters = &east;
+  in.viewpoints = &reachable;
+  const LocalPlanResult r0 = lp.plan(in);
+  EXPECT_EQ(r0.status, LocalPlanStatus::kNewTrajectory) << r0.replan_reason;
+  in.t_s = LocalPlannerOptions{}.replan_period_s + 0.5;
+  in.viewpoints = &across;
+  return lp.plan(in);
+}
 }  // namespace
+
+TEST(LocalPlanner, APeriodicReplanThatFindsNoTrajectoryKeepsTheOneFollowedWithKeepOnFailedReplan) {
+  const LocalPlanResult off = failed_replan(false);
+  EXPECT_NE(off.status, LocalPlanStatus::kKeep) << off.replan_reason;
+  EXPECT_NE(off.status, LocalPlanStatus::kBadInput);
+  const LocalPlanResult on = failed_replan(true);
+  ASSERT_EQ(on.status, LocalPlanStatus::kKeep) << on.replan_reason;
+  EXPECT_STREQ(on.replan_reason,
+               "periodic replan found no trajectory: the one followed is still free");
+  EXPECT_NEAR(on.target_m.x(), 2.2, 0.3);
+  EXPECT_GT(on.real_until_s, 1.0);
+}
 
 TEST(LocalPlanner, AViewpointTheBodyCannotTurnToIsReachedFacingAlongThePathWithArriveAlongPath) {
   const ArriveRun off = run_arrive(false);
