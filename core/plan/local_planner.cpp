@@ -1513,6 +1513,24 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     Eigen::Vector3f hit_m;
   };
   std::vector<Failed> failed;
+  // At a periodic replan, Stage 3 failed for the target's own cluster (or for every cluster):
+  // the trajectory followed was checked free on this map above, so it stays
+  // (PlanOptions::keep_on_failed_replan). Maze seed 1, session 26: from a corner of a narrow
+  // passage a new B-spline found no room to turn that the walk itself did not need; each such
+  // replan escaped or turned back to another cluster, and the one beyond was never reached.
+  const auto keep_followed = [&]() -> LocalPlanResult& {
+    has_target_ = true;
+    next_flight_ = next_flight;
+    planned_at_s_ = in.t_s;
+    out.status = LocalPlanStatus::kKeep;
+    out.replan_reason = "periodic replan found no trajectory: the one followed is still free";
+    out.trajectory = BsplineTrajectory{};
+    out.path_m.clear();
+    out.target_cluster = target_cluster_;
+    out.target_m = target_m_;
+    out.real_until_s = current_.t_end();
+    return out;
+  };
   for (size_t m = 0; m < order.size() && attempts < opt_.max_stage3_attempts; ++m) {
     const Candidate& c = sel[order[m]];
     std::vector<Viewpoint> vps = m < window.size() ? window[m] : viewpoints_of(in, c);
@@ -1528,23 +1546,9 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
       return out;
     }
     failed.push_back({m, why, last_hit_m_});
+    if (still_free && c.cluster_id == kept_cluster) return keep_followed();
   }
-  // Every attempt failed at a periodic replan: the trajectory followed was checked free on this
-  // map above, so it stays (PlanOptions::keep_on_failed_replan; maze seed 1, session 26: each such
-  // replan in a narrow passage escaped, and the cluster beyond it was never reached).
-  if (!failed.empty() && still_free) {
-    has_target_ = true;
-    next_flight_ = next_flight;
-    planned_at_s_ = in.t_s;
-    out.status = LocalPlanStatus::kKeep;
-    out.replan_reason = "periodic replan found no trajectory: the one followed is still free";
-    out.trajectory = BsplineTrajectory{};
-    out.path_m.clear();
-    out.target_cluster = target_cluster_;
-    out.target_m = target_m_;
-    out.real_until_s = current_.t_end();
-    return out;
-  }
+  if (!failed.empty() && still_free) return keep_followed();
   // Every attempt failed. If the robot cannot turn where it stands (a dead end narrower than
   // the body's turning circle: every path back starts with a turn), the clusters are not to
   // blame: step straight to the nearest pose where it can turn, and plan again from there.

@@ -72,10 +72,11 @@ struct PlanOptions {
   // aside.
   bool reach_off_graph = false;
   // Beyond the paper, off (session 27): a periodic replan in which Stage 3 finds no trajectory to
-  // any cluster keeps the trajectory followed, still collision-free on this cycle's map, instead of
-  // an escape. From a pose on a walk through a narrow passage a new B-spline (from rest, at the
-  // robot's heading) may find no room to turn that the walk itself never needed: maze seed 1
-  // (session 26) escaped at the same corner eight times and never reached the cluster beyond it.
+  // the target's cluster (or to any cluster) keeps the trajectory followed, still collision-free on
+  // this cycle's map, instead of an escape or a turn back to another cluster. From a pose on a walk
+  // through a narrow passage a new B-spline (from rest, at the robot's heading) may find no room to
+  // turn that the walk itself never needed: maze seed 1 (session 26) turned back at the same corner
+  // eight times and never reached the cluster beyond it.
   bool keep_on_failed_replan = false;
   // Beyond the paper, off (session 13): at a frontier the blind climb also looks for the flight
   // from up to this far ahead on level ground (flight_axis needs treads 0.6 and 0.9 m ahead; a

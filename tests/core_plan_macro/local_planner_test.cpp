@@ -1449,38 +1449,54 @@ ArriveRun run_arrive(bool on) {
 // corridor; at the periodic replan (it has not moved: held up) the cluster's only viewpoint is
 // one in the gate facing across, which no trajectory reaches (as a replan from a corner of the
 // maze found no room to turn, session 26). The trajectory followed is still free: on, it stays;
-// off, the replan ends in something else (an escape, or no reachable target).
-LocalPlanResult failed_replan(bool on) {
+// off, the replan ends in something else (no reachable target; with a `twin` cluster behind the
+// robot, a turn back to it).
+LocalPlanResult failed_replan(bool on, bool twin) {
   const GateScene s;
-  const auto reachable = s.viewpoint(Eigen::Vector3f(2.2f, 0, 0), 0.0);
-  const auto across = s.viewpoint(Eigen::Vector3f(3, 0, 0), M_PI / 2);
-  if (reachable.empty() || across.empty()) return {};
+  auto vps = s.viewpoint(Eigen::Vector3f(2.2f, 0, 0), 0.0);
+  auto across = s.viewpoint(Eigen::Vector3f(3, 0, 0), M_PI / 2);
+  auto back = s.viewpoint(Eigen::Vector3f(-1.5f, 0, 0), M_PI);
+  if (vps.empty() || across.empty() || back.empty()) return {};
   PlanOptions po;
   po.keep_on_failed_replan = on;
+  po.target_momentum = true;  // the target's cluster stays first in the tour
   LocalPlanner lp(RobotModel{}, po, 0.1);
   const auto view = s.h.map.view();
   LocalPlanInput in = input(s.h, view, Eigen::Vector3f(0, 0, 0), 0.0);
-  std::vector<storey::core::graph::FrontierCluster> east = s.east;
-  in.clusters = &east;
-  in.viewpoints = &reachable;
+  std::vector<storey::core::graph::FrontierCluster> clusters = s.east;
+  in.clusters = &clusters;
+  in.viewpoints = &vps;
   const LocalPlanResult r0 = lp.plan(in);
   EXPECT_EQ(r0.status, LocalPlanStatus::kNewTrajectory) << r0.replan_reason;
   in.t_s = LocalPlannerOptions{}.replan_period_s + 0.5;
+  if (twin) {  // the same frontier nodes under another id, seen from behind the robot
+    clusters.push_back(s.east[0]);
+    clusters.back().id = s.east[0].id + 1;
+    back[0].cluster_id = clusters.back().id;
+    across.push_back(back[0]);
+  }
   in.viewpoints = &across;
   return lp.plan(in);
 }
 }  // namespace
 
-TEST(LocalPlanner, APeriodicReplanThatFindsNoTrajectoryKeepsTheOneFollowedWithKeepOnFailedReplan) {
-  const LocalPlanResult off = failed_replan(false);
-  EXPECT_NE(off.status, LocalPlanStatus::kKeep) << off.replan_reason;
-  EXPECT_NE(off.status, LocalPlanStatus::kBadInput);
-  const LocalPlanResult on = failed_replan(true);
+TEST(LocalPlanner,
+     APeriodicReplanThatFindsNoTrajectoryToItsTargetKeepsTheOneFollowedWithKeepOnFailedReplan) {
+  const LocalPlanResult off = failed_replan(false, false);
+  EXPECT_EQ(off.status, LocalPlanStatus::kNoReachableTarget) << off.replan_reason;
+  const LocalPlanResult on = failed_replan(true, false);
   ASSERT_EQ(on.status, LocalPlanStatus::kKeep) << on.replan_reason;
   EXPECT_STREQ(on.replan_reason,
                "periodic replan found no trajectory: the one followed is still free");
   EXPECT_NEAR(on.target_m.x(), 2.2, 0.3);
   EXPECT_GT(on.real_until_s, 1.0);
+  // The target's cluster failed, the twin behind the robot did not: off, the robot turns back.
+  const LocalPlanResult off_twin = failed_replan(false, true);
+  ASSERT_EQ(off_twin.status, LocalPlanStatus::kNewTrajectory) << off_twin.replan_reason;
+  EXPECT_LT(off_twin.target_m.x(), 0.0);
+  const LocalPlanResult on_twin = failed_replan(true, true);
+  ASSERT_EQ(on_twin.status, LocalPlanStatus::kKeep) << on_twin.replan_reason;
+  EXPECT_NEAR(on_twin.target_m.x(), 2.2, 0.3);
 }
 
 TEST(LocalPlanner, AViewpointTheBodyCannotTurnToIsReachedFacingAlongThePathWithArriveAlongPath) {
