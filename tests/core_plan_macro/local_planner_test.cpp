@@ -1378,11 +1378,6 @@ TEST(LocalPlanner, FrontiersWithNoPathAlongTheGraphAreReachedOnTheMapWithReachOf
   EXPECT_GT(on.end_x_m, 5.5);  // through the opening
 }
 
-// PlanOptions::arrive_along_path. A 2 m corridor with a gate 0.7 m wide and 0.6 m long 3 m
-// ahead: the 0.8 m body box (0.7 m and its margins) walks through it but cannot stand across it.
-// A viewpoint in the gate facing across the corridor (as one beside a ramp's edge faced a
-// frontier behind the robot on test_ramp, session 26): off, every trajectory to it collides where
-// it turns and the cluster fails Stage 3; on, the robot arrives there facing along the corridor.
 namespace {
 // The corridor with the gate, scanned from the origin: the easternmost cluster (the graph stops
 // at the gate) and a viewpoint of it at `at` (on the graph node nearest it) facing `yaw`.
@@ -1415,6 +1410,11 @@ struct GateScene {
   }
 };
 
+// PlanOptions::arrive_along_path. A 2 m corridor with a gate 0.7 m wide and 0.6 m long 3 m
+// ahead: the 0.8 m body box (0.7 m and its margins) walks through it but cannot stand across it.
+// A viewpoint in the gate facing across the corridor (as one beside a ramp's edge faced a
+// frontier behind the robot on test_ramp, session 26): off, every trajectory to it collides where
+// it turns and the cluster fails Stage 3; on, the robot arrives there facing along the corridor.
 struct ArriveRun {
   LocalPlanStatus status = LocalPlanStatus::kBadInput;
   Eigen::Vector3d end_m = Eigen::Vector3d::Zero();
