@@ -293,12 +293,7 @@ void LocalPlanner::adopt_target(const LocalPlanInput& in, const graph::FrontierC
       has_target_ = true;
       remember_target(in, c);
       planned_at_s_ = in.t_s;
-      out = LocalPlanResult{};
-      out.status = LocalPlanStatus::kKeep;
-      out.target_cluster = target_cluster_;
-      out.target_m = target_m_;
-      out.real_until_s = current_.t_end();
-      out.replan_reason = "periodic replan: the trajectory followed arrives as early";
+      keep_current(out, "periodic replan: the trajectory followed arrives as early");
       return;
     }
   }
@@ -311,6 +306,18 @@ void LocalPlanner::adopt_target(const LocalPlanInput& in, const graph::FrontierC
   planned_at_s_ = in.t_s;
   out.target_cluster = c.id;
   out.status = LocalPlanStatus::kNewTrajectory;
+}
+
+LocalPlanResult& LocalPlanner::keep_current(LocalPlanResult& out, const char* reason) const {
+  out.status = LocalPlanStatus::kKeep;
+  out.replan_reason = reason;
+  out.trajectory = BsplineTrajectory{};
+  out.path_m.clear();
+  out.target_cluster = target_cluster_;
+  out.target_m = target_m_;
+  out.target_yaw_rad = 0;
+  out.real_until_s = current_.t_end();
+  return out;
 }
 
 double LocalPlanner::from_start_m(const Eigen::Vector3f& hit_m) const {
@@ -1238,13 +1245,9 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
         still_free =
             plan_opt_.keep_on_failed_replan && tc && !climb_start_ && !retrying_ && !climbing_;
       } else {
-        out.status = LocalPlanStatus::kKeep;
         flight_target_ = flight_target;
         next_flight_ = next_flight;
-        out.target_cluster = target_cluster_;
-        out.target_m = target_m_;
-        out.real_until_s = current_.t_end();
-        return out;
+        return keep_current(out, "");
       }
     }
   }
@@ -1522,14 +1525,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     has_target_ = true;
     next_flight_ = next_flight;
     planned_at_s_ = in.t_s;
-    out.status = LocalPlanStatus::kKeep;
-    out.replan_reason = "periodic replan found no trajectory: the one followed is still free";
-    out.trajectory = BsplineTrajectory{};
-    out.path_m.clear();
-    out.target_cluster = target_cluster_;
-    out.target_m = target_m_;
-    out.real_until_s = current_.t_end();
-    return out;
+    return keep_current(out, "periodic replan found no trajectory: the one followed is still free");
   };
   for (size_t m = 0; m < order.size() && attempts < opt_.max_stage3_attempts; ++m) {
     const Candidate& c = sel[order[m]];

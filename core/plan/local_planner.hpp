@@ -234,6 +234,9 @@ class LocalPlanner {
   // current one, with c as the target.
   void adopt_target(const LocalPlanInput& in, const graph::FrontierCluster& c,
                     LocalPlanResult& out);
+  // out becomes a kKeep of the trajectory followed, to the current target (no trajectory or
+  // path of its own: a Stage 3 try may have left one there). The caller owns the state.
+  LocalPlanResult& keep_current(LocalPlanResult& out, const char* reason) const;
   // Distance from the Stage 3 start to a body hit (infinite for kNoHitM) [m].
   double from_start_m(const Eigen::Vector3f& hit_m) const;
   // out's trajectory (an escape, a climb, a walk: to a pose, not to a cluster) becomes the
