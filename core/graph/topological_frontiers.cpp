@@ -20,6 +20,16 @@ TopologicalFrontiers::TopologicalFrontiers(const GraphOptions& opt) : opt_(opt) 
   }
 }
 
+int passage_probes(std::span<const ProbeState> ring) {
+  const size_t n = ring.size();
+  if (n < 3) return 0;
+  int passages = 0;
+  for (size_t k = 0; k < n; ++k)
+    passages += ring[k] == ProbeState::kOpen && ring[(k + n - 1) % n] == ProbeState::kBlocked &&
+                ring[(k + 1) % n] == ProbeState::kBlocked;
+  return passages;
+}
+
 // Eq. 5. I(x, z_i) = 1 if a support surface lies within a step of z_i under x, or if x is an
 // observed drop (known, so not under-observed). Samples hidden behind an obstacle at body
 // height (walls) are not part of the node's region and are left out of Omega_i. With
@@ -58,7 +68,6 @@ float TopologicalFrontiers::missing_surface_ratio(SupportQuery& q, const GraphNo
 // climbed first.
 int TopologicalFrontiers::open_directions(SupportQuery& q, const ReachableGraph& g, NodeId i,
                                           int* up, int* leads, int* passages) {
-  enum : uint8_t { kOther = 0, kOpen, kBlocked };
   const GraphNode& n = g.node(i);
   const int probes = std::max(1, opt_.probes);
   const float half = float(opt_.alpha_min_rad) * 0.5f;
@@ -66,7 +75,7 @@ int TopologicalFrontiers::open_directions(SupportQuery& q, const ReachableGraph&
   int open = 0;
   *up = 0;
   if (leads) *leads = 0;
-  probe_state_.assign(size_t(probes), kOther);
+  probe_state_.assign(size_t(probes), ProbeState::kOther);
   for (int k = 0; k < probes; ++k) {
     const float th = 2.0f * float(M_PI) * float(k) / float(probes);
     bool covered = false;
@@ -82,20 +91,14 @@ int TopologicalFrontiers::open_directions(SupportQuery& q, const ReachableGraph&
                                          float(opt_.probe_length_m), float(opt_.probe_height_m),
                                          min_free, float(opt_.probe_unknown_m), &climbed,
                                          leads ? &out_of_reach : nullptr, &blocked);
-    probe_state_[size_t(k)] = o ? kOpen : blocked ? kBlocked : kOther;
+    probe_state_[size_t(k)] = o         ? ProbeState::kOpen
+                              : blocked ? ProbeState::kBlocked
+                                        : ProbeState::kOther;
     open += o;
     *up += o && climbed;
     if (leads) *leads += out_of_reach;
   }
-  if (passages) {  // an open probe, its neighbours closed, one of them by an obstacle
-    *passages = 0;
-    for (int k = 0; k < probes && probes >= 3; ++k) {
-      const uint8_t a = probe_state_[size_t((k + probes - 1) % probes)];
-      const uint8_t b = probe_state_[size_t((k + 1) % probes)];
-      *passages += probe_state_[size_t(k)] == kOpen && a != kOpen && b != kOpen &&
-                   (a == kBlocked || b == kBlocked);
-    }
-  }
+  if (passages) *passages = passage_probes(probe_state_);
   return open;
 }
 

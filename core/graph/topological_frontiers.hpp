@@ -30,6 +30,15 @@ struct FrontierUpdateStats {
   uint32_t pending = 0;
 };
 
+// One C_exp probe's outcome: open (Sec. III-C), blocked by an obstacle (or a hole in a
+// surface), or neither (ran out in known free space, or started in unknown space).
+enum class ProbeState : uint8_t { kOther = 0, kOpen, kBlocked };
+// GraphOptions::passage_frontiers: the open probes of a ring (probes in angular order) whose
+// two neighbours are both blocked: a corridor or door one probe wide, walls either side. A
+// neighbour that ran out in known free space (a door seen from its room's side) or started in
+// unknown space does not count: with either allowed the office was slower (session 28).
+int passage_probes(std::span<const ProbeState> ring);
+
 class TopologicalFrontiers {
  public:
   explicit TopologicalFrontiers(const GraphOptions& opt = {});
@@ -53,8 +62,7 @@ class TopologicalFrontiers {
 
  private:
   float missing_surface_ratio(SupportQuery& q, const GraphNode& n, int* samples);  // Eq. 5
-  // *passages (optional): open probes whose two neighbours are closed, one of them by an
-  // obstacle (GraphOptions::passage_frontiers).
+  // *passages (optional): passage_probes() of the probes cast (GraphOptions::passage_frontiers).
   int open_directions(SupportQuery& q, const ReachableGraph& g, NodeId i, int* up,
                       int* leads = nullptr, int* passages = nullptr);
   bool near_reach_boundary(SupportQuery& q, const GraphNode& n);
@@ -67,7 +75,7 @@ class TopologicalFrontiers {
   std::vector<uint8_t> queued_;
   std::vector<NodeId> scratch_;
   std::vector<uint8_t> cls_;
-  std::vector<uint8_t> probe_state_;  // open_directions: per probe (scratch)
+  std::vector<ProbeState> probe_state_;  // open_directions: per probe (scratch)
   std::vector<Aabb> boxes_, opened_;
 };
 
