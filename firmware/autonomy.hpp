@@ -158,6 +158,12 @@ class Autonomy {
   ExplorationStatus status() const;
   std::shared_ptr<const WorldModel> world() const { return world_.read().ptr; }
   std::shared_ptr<const PlannedTrajectory> trajectory() const { return traj_.read().ptr; }
+  // The trajectory the control task follows and how far its reference trails the clock.
+  TrajectoryProgress trajectory_progress() const {
+    TrajectoryProgress p;
+    progress_mb_.read(p);
+    return p;
+  }
   VelocityCommand last_command() const;
   uint64_t safety_stops() const { return safety_stops_.load(std::memory_order_acquire); }
   uint64_t stop_events(StopReason r) const {

@@ -254,6 +254,26 @@ void write_record(const RecordInputs& in, std::vector<std::string>& written) {
   }
 }
 
+// Where the body stood against its reference when it hit something or fell. The planner and the
+// control look-ahead check the reference's poses, not the body's: a body off its reference meets
+// what those checks cleared.
+std::string against_reference(const firmware::Autonomy& a, double t, const RobotState& rs) {
+  const auto traj = a.trajectory();
+  const firmware::TrajectoryProgress pr = a.trajectory_progress();
+  if (!traj || traj->trajectory.empty()) return "; no trajectory";
+  if (pr.id != traj->id) return "; following an earlier trajectory";
+  const core::plan::BodyPose ref = traj->trajectory.pose(t - pr.lag_s);
+  const Eigen::Vector2d d = rs.position.head<2>() - ref.foot_m.head<2>();
+  const double c = std::cos(ref.yaw_rad), s = std::sin(ref.yaw_rad);
+  char buf[200];
+  std::snprintf(buf, sizeof buf,
+                "; reference (%.2f, %.2f) m, yaw %.0f deg: body %.2f m ahead, %.2f m left, "
+                "%.0f deg off",
+                ref.foot_m.x(), ref.foot_m.y(), ref.yaw_rad * 180 / M_PI, c * d.x() + s * d.y(),
+                -s * d.x() + c * d.y(),
+                std::remainder(rs.yaw - ref.yaw_rad, 2 * M_PI) * 180 / M_PI);
+  return buf;
+}
 }  // namespace
 
 SimRunResult run_exploration(const SimRunOptions& opt) {
@@ -340,11 +360,12 @@ SimRunResult run_exploration(const SimRunOptions& opt) {
           rs.collisions != collisions_seen || rs.falls != falls_seen) {
         char line[200];
         std::snprintf(line, sizeof line,
-                      "  sim: t=%.2f s: %s at (%.2f, %.2f, %.2f) m, yaw %.0f deg, pitch %.0f deg",
+                      "  sim: t=%.2f s: %s at (%.2f, %.2f, %.2f) m, yaw %.0f deg, pitch %.0f deg, "
+                      "roll %.0f deg",
                       t, rs.collisions != collisions_seen ? "body collision" : "fall",
                       rs.position.x(), rs.position.y(), rs.position.z(), rs.yaw * 180 / M_PI,
-                      rs.pitch * 180 / M_PI);
-        progress(line);
+                      rs.pitch * 180 / M_PI, rs.roll * 180 / M_PI);
+        progress(std::string(line).append(against_reference(autonomy, t, rs)));
         collisions_seen = rs.collisions;
         falls_seen = rs.falls;
       }
