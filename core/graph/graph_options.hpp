@@ -28,11 +28,11 @@ struct GraphOptions {
   // a wall's face where a voxel of it has free space over it takes no "step" there (the wall
   // rises on behind it, SupportQuery::wall_face); off, such a voxel seen edge-on is a tread.
   bool close_probes_at_wall_faces = false;
-  // Beyond the paper, off (graph.passage_frontiers, session 26): C_exp also holds for an open
-  // probe whose two neighbours are closed, one of them at an obstacle (the other may start in
-  // space the sparse scan left unknown): a corridor or door one probe wide, the level analogue
-  // of the flight rule (climb_frontiers). With close_probes_at_wall_faces a corridor's end
-  // had one open probe only (Theta_min = 2) and test_ramp's upper corridors were left unexplored.
+  // Beyond the paper, off (graph.passage_frontiers, sessions 26, 28): C_exp also holds for an
+  // open probe whose two neighbours are both blocked by obstacles (passage_probes): a corridor or
+  // door one probe wide, the level analogue of the flight rule (climb_frontiers). With
+  // close_probes_at_wall_faces a corridor's end had one open probe only (Theta_min = 2) and
+  // test_ramp's upper corridors were left unexplored.
   bool passage_frontiers = false;
   double probe_length_m = 3.0;      // probe length for C_exp
   int cluster_capacity = 8;         // maximum frontier nodes per cluster
