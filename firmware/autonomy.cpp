@@ -492,6 +492,12 @@ void Autonomy::control_step() {
   const bool has_traj = ctl_traj_ && !ctl_traj_->trajectory.empty();
   const double tau_end =
       has_traj ? std::min(ctl_traj_->trajectory.t_end(), ctl_traj_->real_until_s) : 0;
+  if (has_traj && !pending_ && tau_ < tau_end && opt_.params.plan.reference_catch_up) {
+    const double s = ControlLaw::catch_up_time(ctl_traj_->trajectory, tau_, tau_end,
+                                               Eigen::Vector2d(last_pose_.x_m, last_pose_.y_m));
+    lag_s_ = std::max(0.0, lag_s_ - (s - tau_));
+    tau_ = s;
+  }
   core::plan::TrajectorySample ref;
   double err = 0;
   if (has_traj) {
@@ -569,7 +575,7 @@ void Autonomy::control_step() {
   } else if (has_traj && tau_ < tau_end) {
     lag_s_ += dt;  // stopped: the reference waits
   }
-  progress_mb_.write(TrajectoryProgress{has_traj ? ctl_traj_->id : 0, lag_s_});
+  progress_mb_.write(TrajectoryProgress{has_traj ? ctl_traj_->id : 0, lag_s_, tau_});
   // else: zero command (a stop is commanded in this very period; the robot's own deceleration
   // limits bring it to rest).
   cmd.stamp_s = now;

@@ -64,6 +64,7 @@ struct PlannedTrajectory {
 struct TrajectoryProgress {
   uint64_t id = 0;   // PlannedTrajectory::id followed (0: none)
   double lag_s = 0;  // how far its reference trails the clock [s]
+  double tau_s = 0;  // the reference's time now, on the trajectory's clock [s]
 };
 
 enum class ExplorationState : uint8_t { kStarting = 0, kExploring, kComplete };

@@ -107,4 +107,20 @@ double ControlLaw::entry_time(const core::plan::BsplineTrajectory& t, const Eige
   return tau;
 }
 
+double ControlLaw::catch_up_time(const core::plan::BsplineTrajectory& t, double tau, double tau_end,
+                                 const Eigen::Vector2d& at) {
+  constexpr double kStepS = 0.05, kGainM = 0.1, kRiseM = 0.02;
+  const double end = std::min({t.t_end(), tau_end, tau + 2.0});
+  const double d0 = (t.sample(tau).p_m.head<2>() - at).norm();
+  double best = d0, best_s = tau;
+  for (double s = tau + kStepS; s <= end + 1e-9; s += kStepS) {
+    const double d = (t.sample(s).p_m.head<2>() - at).norm();
+    if (d < best)
+      best = d, best_s = s;
+    else if (d > best + kRiseM)
+      break;  // past the first closest approach
+  }
+  return d0 - best > kGainM ? best_s : tau;
+}
+
 }  // namespace storey::firmware

@@ -41,6 +41,13 @@ class ControlLaw {
   // planner started it: entered while moving, a trajectory that turns back passes the robot's
   // position later, and tracking from there cut the turn short into a railing (house seed 2).
   static double entry_time(const core::plan::BsplineTrajectory& t, const Eigen::Vector2d& at);
+  // plan.reference_catch_up: the reference time to follow from tau for a robot at `at`. A robot
+  // ahead of its reference (a new trajectory starts at rest; one entered at walking speed is
+  // overshot by up to v^2 / (2 a_max)): the first point of the path from tau (up to tau + 2 s and
+  // tau_end) nearest the robot, if more than 0.1 m nearer than the reference; else tau. Only the
+  // first closest approach counts: a path that doubles back past the robot is not cut short.
+  static double catch_up_time(const core::plan::BsplineTrajectory& t, double tau, double tau_end,
+                              const Eigen::Vector2d& at);
   // A new trajectory that, within twice the robot's stopping distance + 0.3 m of path (judged
   // along the curve, whatever its timing), heads more than 60 deg off the robot's velocity v
   // (world frame), turns the body more than 0.5 rad, or ends: the robot brakes on the trajectory

@@ -116,6 +116,10 @@ struct PlanOptions {
   // The planner judges the followed trajectory's end on its reference's own clock
   // (LocalPlanInput::trajectory_lag_s, from the control task), not on its planned duration.
   bool reference_clock = false;
+  // Beyond the paper (session 28): the reference never trails a robot that is ahead of it on
+  // the trajectory; it moves on to the trajectory's point nearest the robot
+  // (ControlLaw::catch_up_time). Held back, it pulled the body off the checked path.
+  bool reference_catch_up = false;
   bool incremental_maintenance = true;
 };
 

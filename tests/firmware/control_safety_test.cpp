@@ -123,6 +123,36 @@ TEST(ControlLaw, ANewTrajectoryIsEnteredNearestWhereTheRobotComesToRest) {
   EXPECT_TRUE(law.turns_away(turn, {0.0, -0.8}));
 }
 
+// plan.reference_catch_up: a new trajectory starts at rest, and a robot entering it at walking
+// speed runs ahead of its reference (office seed 2 with graph.close_probes_at_wall_faces, 419 s:
+// the body 0.47 m ahead and 0.11 m to the side of it met a table leg). The reference moves on to
+// the path's point nearest the robot; it never moves for a robot behind it or beside it, and a
+// path that doubles back past the robot is followed round, not cut short.
+TEST(ControlLaw, TheReferenceCatchesUpWithARobotAheadOfIt) {
+  // Along +x from rest at x = 0, 1 s per knot, to x = 3.
+  std::vector<Eigen::Vector3d> ctrl;
+  for (double x : {0.0, 0.0, 0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 3.0, 3.0})
+    ctrl.emplace_back(x, 0.0, 0.0);
+  const core::plan::BsplineTrajectory t(ctrl, std::vector<double>(ctrl.size(), 0.0), 1.0, 10.0);
+  const double end = t.t_end();
+  const double s = ControlLaw::catch_up_time(t, 10.0, end, {0.5, 0.05});  // 0.5 m ahead
+  EXPECT_GT(s, 10.0);
+  EXPECT_NEAR(t.sample(s).p_m.x(), 0.5, 0.06);
+  EXPECT_EQ(ControlLaw::catch_up_time(t, 10.0, end, {0.05, 0.0}), 10.0);   // within 0.1 m
+  EXPECT_EQ(ControlLaw::catch_up_time(t, 10.0, end, {-0.6, 0.0}), 10.0);   // behind
+  EXPECT_EQ(ControlLaw::catch_up_time(t, 10.0, end, {0.0, 0.5}), 10.0);    // beside the start
+  EXPECT_EQ(ControlLaw::catch_up_time(t, 12.0, 12.0, {2.0, 0.0}), 12.0);   // at tau_end
+  const double far = ControlLaw::catch_up_time(t, 10.0, end, {3.0, 0.0});  // at most 2 s on
+  EXPECT_LE(far, 12.0 + 1e-9);
+  // Out along +x to x = 1 and back through the start to x = -1: a robot at x = -0.5 (where the
+  // path passes again later) is behind the reference at the start, not ahead of it.
+  std::vector<Eigen::Vector3d> back;
+  for (double x : {0.0, 0.0, 0.0, 0.5, 1.0, 0.5, 0.0, -0.5, -1.0, -1.0, -1.0})
+    back.emplace_back(x, 0.0, 0.0);
+  const core::plan::BsplineTrajectory u(back, std::vector<double>(back.size(), 0.0), 0.2, 10.0);
+  EXPECT_EQ(ControlLaw::catch_up_time(u, 10.0, u.t_end(), {-0.5, 0.0}), 10.0);
+}
+
 // Judged along the curve, not its clock: a re-timed trajectory leaves its start at rest at the
 // acceleration limit, so its first second covers under 0.5 m and a bend just beyond went unseen
 // (maze seed 1, 1030 s: entered at 0.97 m/s, the body overshot 0.45 m into a wall).

@@ -257,12 +257,12 @@ void write_record(const RecordInputs& in, std::vector<std::string>& written) {
 // Where the body stood against its reference when it hit something or fell. The planner and the
 // control look-ahead check the reference's poses, not the body's: a body off its reference meets
 // what those checks cleared.
-std::string against_reference(const firmware::Autonomy& a, double t, const RobotState& rs) {
+std::string against_reference(const firmware::Autonomy& a, const RobotState& rs) {
   const auto traj = a.trajectory();
   const firmware::TrajectoryProgress pr = a.trajectory_progress();
   if (!traj || traj->trajectory.empty()) return "; no trajectory";
   if (pr.id != traj->id) return "; following an earlier trajectory";
-  const core::plan::BodyPose ref = traj->trajectory.pose(t - pr.lag_s);
+  const core::plan::BodyPose ref = traj->trajectory.pose(pr.tau_s);
   const Eigen::Vector2d d = rs.position.head<2>() - ref.foot_m.head<2>();
   const double c = std::cos(ref.yaw_rad), s = std::sin(ref.yaw_rad);
   char buf[200];
@@ -365,7 +365,7 @@ SimRunResult run_exploration(const SimRunOptions& opt) {
                       t, rs.collisions != collisions_seen ? "body collision" : "fall",
                       rs.position.x(), rs.position.y(), rs.position.z(), rs.yaw * 180 / M_PI,
                       rs.pitch * 180 / M_PI, rs.roll * 180 / M_PI);
-        progress(std::string(line).append(against_reference(autonomy, t, rs)));
+        progress(std::string(line).append(against_reference(autonomy, rs)));
         collisions_seen = rs.collisions;
         falls_seen = rs.falls;
       }
