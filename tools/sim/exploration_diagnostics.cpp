@@ -163,7 +163,7 @@ std::string exploration_diagnostics(const firmware::Autonomy& autonomy, const Gr
   }
   out += "## Ground-truth traversable voxels not covered, by what the map holds there\n\n";
   out += "| floor | truth voxels | covered | uncovered | at the edge of the truth |";
-  for (int g = 0; g < kGapCount; ++g) out += " " + std::string(kGapNames[g]) + " |";
+  for (int g = 0; g < kGapCount; ++g) out.append(" ").append(kGapNames[g]).append(" |");
   out += "\n|---|---|---|---|---|";
   for (int g = 0; g < kGapCount; ++g) out += "---|";
   out += "\n";
@@ -171,7 +171,8 @@ std::string exploration_diagnostics(const firmware::Autonomy& autonomy, const Gr
     out += "| " + std::to_string(fl) + " | " + std::to_string(total[fl]) + " | " +
            f("%.1f %%", total[fl] ? 100.0 * double(covered[fl]) / double(total[fl]) : 0.0) + " | " +
            std::to_string(total[fl] - covered[fl]) + " | " + std::to_string(edge[fl]) + " |";
-    for (int g = 0; g < kGapCount; ++g) out += " " + std::to_string(gaps[fl][g]) + " |";
+    for (int g = 0; g < kGapCount; ++g)
+      out.append(" ").append(std::to_string(gaps[fl][g])).append(" |");
     out += "\n";
   }
   // The 1 m x 1 m cells with the most uncovered voxels (where the holes are).
