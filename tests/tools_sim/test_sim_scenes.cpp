@@ -165,12 +165,27 @@ TEST(SimMetrics, CoverageCountsOneVoxelVerticalTolerance) {
   EXPECT_EQ(m.floors_total, 2);
   EXPECT_EQ(m.floors_explored, 2);
   const std::string j = sim::metrics_json(m);
-  for (const char* key :
-       {"\"success\"", "\"floors_total\"", "\"floors_explored\"", "\"exploration_time_s\"",
-        "\"trajectory_length_m\"", "\"walking_time_s\"", "\"traversable_volume_m3\"",
-        "\"occupied_volume_m3\"", "\"traversable_coverage\"", "\"per_floor\"", "\"time_s\"",
-        "\"collisions\"", "\"falls\"", "\"safety_stops\"", "\"latency\"", "\"method\"",
-        "\"ablation\"", "\"completed\"", "\"end_reason\""})
+  for (const char* key : {"\"success\"",
+                          "\"floors_total\"",
+                          "\"floors_explored\"",
+                          "\"exploration_time_s\"",
+                          "\"trajectory_length_m\"",
+                          "\"walking_time_s\"",
+                          "\"traversable_volume_m3\"",
+                          "\"occupied_volume_m3\"",
+                          "\"traversable_coverage\"",
+                          "\"per_floor\"",
+                          "\"time_s\"",
+                          "\"collisions\"",
+                          "\"falls\"",
+                          "\"safety_stops\"",
+                          "\"tracking\"",
+                          "\"side_p99_m\"",
+                          "\"latency\"",
+                          "\"method\"",
+                          "\"ablation\"",
+                          "\"completed\"",
+                          "\"end_reason\""})
     EXPECT_NE(j.find(key), std::string::npos) << key;
 }
 

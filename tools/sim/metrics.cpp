@@ -100,8 +100,12 @@ std::string metrics_json(const RunMetrics& m) {
   for (std::size_t i = 0; i < m.per_floor.size(); ++i)
     add("%s\n    {\"z_m\": %.2f, \"time_s\": %.3f, \"traversable_coverage\": %.4f}", i ? "," : "",
         m.per_floor[i].z_m, m.per_floor[i].time_s, m.per_floor[i].traversable_coverage);
-  add("\n  ],\n  \"collisions\": %u,\n  \"falls\": %u,\n  \"safety_stops\": %u,\n  \"latency\": {",
-      m.collisions, m.falls, m.safety_stops);
+  add("\n  ],\n  \"collisions\": %u,\n  \"falls\": %u,\n  \"safety_stops\": %u,\n", m.collisions,
+      m.falls, m.safety_stops);
+  add("  \"tracking\": {\"side_p50_m\": %.3f, \"side_p99_m\": %.3f, \"side_max_m\": %.3f, "
+      "\"ahead_max_m\": %.3f, \"samples\": %llu},\n  \"latency\": {",
+      m.tracking.side_p50_m, m.tracking.side_p99_m, m.tracking.side_max_m, m.tracking.ahead_max_m,
+      static_cast<unsigned long long>(m.tracking.samples));
   for (std::size_t i = 0; i < m.latency.size(); ++i) {
     std::string name;
     for (char c : m.latency[i].task)

@@ -49,6 +49,14 @@ struct LatencyMetrics {
   double p50_ms = 0.0, p99_ms = 0.0, max_ms = 0.0;
   uint64_t overruns = 0;
 };
+// How far the body strayed from its reference pose on the trajectory it followed (every 10 ms
+// of simulated time while one was followed). The planner and the control look-ahead check the
+// reference's poses, not the body's: `side` is the body's distance to the reference's left or
+// right, `ahead` how far it ran ahead of the reference along its heading.
+struct TrackingMetrics {
+  double side_p50_m = 0.0, side_p99_m = 0.0, side_max_m = 0.0, ahead_max_m = 0.0;
+  uint64_t samples = 0;
+};
 // DESIGN §7 metrics.json. The simulator fills the truth-derived fields; the firmware the rest.
 struct RunMetrics {
   bool success = false;
@@ -65,6 +73,7 @@ struct RunMetrics {
   double traversable_coverage = 0.0;
   std::vector<FloorMetrics> per_floor;
   uint32_t collisions = 0, falls = 0, safety_stops = 0;
+  TrackingMetrics tracking;
   std::vector<LatencyMetrics> latency;
   std::vector<std::pair<double, double>> coverage_over_time;  // (t [s], coverage 0..1)
 };

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -228,7 +229,10 @@ void write_record(const RecordInputs& in, std::vector<std::string>& written) {
   r << "| occupied volume (observed / truth) | " << fmt("%.2f", m.occupied_volume_m3) << " / "
     << fmt("%.2f m^3", m.gt_occupied_volume_m3) << " |\n";
   r << "| collisions / falls / safety stops | " << m.collisions << " / " << m.falls << " / "
-    << m.safety_stops << " |\n\n";
+    << m.safety_stops << " |\n";
+  r << "| body beside its reference: p50 / p99 / max (most ahead of it) | "
+    << fmt("%.2f", m.tracking.side_p50_m) << " / " << fmt("%.2f", m.tracking.side_p99_m) << " / "
+    << fmt("%.2f m", m.tracking.side_max_m) << fmt(" (%.2f m)", m.tracking.ahead_max_m) << " |\n\n";
   r << "## Floors\n\n| floor | z [m] | coverage | time to 90 % [s] |\n|---|---|---|---|\n";
   for (size_t f = 0; f < m.per_floor.size(); ++f)
     r << "| " << f << " | " << fmt("%.2f", m.per_floor[f].z_m) << " | "
@@ -254,24 +258,46 @@ void write_record(const RecordInputs& in, std::vector<std::string>& written) {
   }
 }
 
-// Where the body stood against its reference when it hit something or fell. The planner and the
-// control look-ahead check the reference's poses, not the body's: a body off its reference meets
-// what those checks cleared.
-std::string against_reference(const firmware::Autonomy& a, const RobotState& rs) {
+// The body against its reference pose on the trajectory the control task follows (nullopt, with
+// *why, when it follows none or one the plan task has already replaced). The planner and the
+// control look-ahead check the reference's poses, not the body's: a body off its reference
+// meets what those checks cleared.
+struct ReferenceOffset {
+  core::plan::BodyPose ref;
+  double ahead_m = 0, left_m = 0, yaw_off_rad = 0;
+};
+std::optional<ReferenceOffset> reference_offset(const firmware::Autonomy& a, const RobotState& rs,
+                                                const char** why = nullptr) {
   const auto traj = a.trajectory();
   const firmware::TrajectoryProgress pr = a.trajectory_progress();
-  if (!traj || traj->trajectory.empty()) return "; no trajectory";
-  if (pr.id != traj->id) return "; following an earlier trajectory";
-  const core::plan::BodyPose ref = traj->trajectory.pose(pr.tau_s);
-  const Eigen::Vector2d d = rs.position.head<2>() - ref.foot_m.head<2>();
-  const double c = std::cos(ref.yaw_rad), s = std::sin(ref.yaw_rad);
+  const char* no = !traj || traj->trajectory.empty() ? "no trajectory"
+                   : pr.id != traj->id               ? "following an earlier trajectory"
+                                                     : nullptr;
+  if (no) {
+    if (why) *why = no;
+    return std::nullopt;
+  }
+  ReferenceOffset o;
+  o.ref = traj->trajectory.pose(pr.tau_s);
+  const Eigen::Vector2d d = rs.position.head<2>() - o.ref.foot_m.head<2>();
+  const double c = std::cos(o.ref.yaw_rad), s = std::sin(o.ref.yaw_rad);
+  o.ahead_m = c * d.x() + s * d.y();
+  o.left_m = -s * d.x() + c * d.y();
+  o.yaw_off_rad = std::remainder(rs.yaw - o.ref.yaw_rad, 2 * M_PI);
+  return o;
+}
+
+// For the collision and fall lines of the log.
+std::string against_reference(const firmware::Autonomy& a, const RobotState& rs) {
+  const char* why = "";
+  const auto o = reference_offset(a, rs, &why);
+  if (!o) return std::string("; ") + why;
   char buf[200];
   std::snprintf(buf, sizeof buf,
                 "; reference (%.2f, %.2f) m, yaw %.0f deg: body %.2f m ahead, %.2f m left, "
                 "%.0f deg off",
-                ref.foot_m.x(), ref.foot_m.y(), ref.yaw_rad * 180 / M_PI, c * d.x() + s * d.y(),
-                -s * d.x() + c * d.y(),
-                std::remainder(rs.yaw - ref.yaw_rad, 2 * M_PI) * 180 / M_PI);
+                o->ref.foot_m.x(), o->ref.foot_m.y(), o->ref.yaw_rad * 180 / M_PI, o->ahead_m,
+                o->left_m, o->yaw_off_rad * 180 / M_PI);
   return buf;
 }
 }  // namespace
@@ -348,6 +374,8 @@ SimRunResult run_exploration(const SimRunOptions& opt) {
   const std::int64_t progress_ns = std::int64_t(std::llround(opt.progress_period_s * 1e9));
   std::int64_t t_ns = 0, next_progress = progress_ns, next_path = 0;
   uint32_t collisions_seen = 0, falls_seen = 0;
+  std::vector<float> side_m;  // |body to reference, sideways| every slice (RunMetrics::tracking)
+  double ahead_max_m = 0;
   std::string error;
   try {
     for (;;) {
@@ -368,6 +396,10 @@ SimRunResult run_exploration(const SimRunOptions& opt) {
         progress(std::string(line).append(against_reference(autonomy, rs)));
         collisions_seen = rs.collisions;
         falls_seen = rs.falls;
+      }
+      if (const auto o = reference_offset(autonomy, world.robot_state())) {
+        side_m.push_back(float(std::abs(o->left_m)));
+        ahead_max_m = std::max(ahead_max_m, o->ahead_m);
       }
       if (t_ns >= next_path) {
         path.push_back(world.robot_state().position);
@@ -429,6 +461,18 @@ SimRunResult run_exploration(const SimRunOptions& opt) {
   m.collisions = rs.collisions;
   m.falls = rs.falls;
   m.safety_stops = uint32_t(autonomy.safety_stops());
+  if (!side_m.empty()) {
+    const auto at = [&](double q) {
+      auto k = side_m.begin() + std::ptrdiff_t(q * double(side_m.size() - 1));
+      std::nth_element(side_m.begin(), k, side_m.end());
+      return double(*k);
+    };
+    m.tracking.side_p50_m = at(0.5);
+    m.tracking.side_p99_m = at(0.99);
+    m.tracking.side_max_m = at(1.0);
+    m.tracking.ahead_max_m = ahead_max_m;
+    m.tracking.samples = side_m.size();
+  }
   for (const auto& tr : autonomy.scheduler().reports()) {
     LatencyMetrics l;
     l.task = tr.name;
