@@ -29,6 +29,12 @@ TEST(ExploreHouse, BothFloorsSafelyAndDeterministically) {
   // the five switches session 18 turned on: 146.0 s, 0.968 / 0.957; docs/RESULTS.md).
   expect_every_floor_explored_safely(a, 2);
   EXPECT_GT(m.trajectory_length_m, 5.0);
+  // The body beside its reference, every 10 ms (RunMetrics::tracking; seed 1, session 28: p50
+  // 0.002, p99 0.039, max 0.060 m). The planner and the look-ahead check the reference's poses
+  // with robot.body_margin_m (0.05 m): at p99 the body must stay within it.
+  EXPECT_GT(m.tracking.samples, 5000u);
+  EXPECT_LT(m.tracking.side_p99_m, 0.05);
+  EXPECT_GT(m.tracking.side_max_m, m.tracking.side_p50_m);
 
   const SimRunResult b = run_exploration(o);
   const RunMetrics& n = b.metrics;
@@ -41,6 +47,8 @@ TEST(ExploreHouse, BothFloorsSafelyAndDeterministically) {
   EXPECT_EQ(m.occupied_volume_m3, n.occupied_volume_m3);
   EXPECT_EQ(m.safety_stops, n.safety_stops);
   EXPECT_EQ(m.coverage_over_time, n.coverage_over_time);
+  EXPECT_EQ(m.tracking.side_max_m, n.tracking.side_max_m);
+  EXPECT_EQ(m.tracking.samples, n.tracking.samples);
 }
 
 // The paper-literal pipeline (no blind climb, no phantom-frontier fixes, no retries) still
