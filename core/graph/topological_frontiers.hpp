@@ -34,9 +34,10 @@ struct FrontierUpdateStats {
 // surface), or neither (ran out in known free space, or started in unknown space).
 enum class ProbeState : uint8_t { kOther = 0, kOpen, kBlocked };
 // GraphOptions::passage_frontiers: the open probes of a ring (probes in angular order) whose
-// two neighbours are both blocked: a corridor or door one probe wide, walls either side. A
-// neighbour that ran out in known free space (a door seen from its room's side) or started in
-// unknown space does not count: with either allowed the office was slower (session 28).
+// two neighbours are both blocked: a corridor or door one probe wide, walls either side
+// (test_ramp's upper corridors' ends, session 28). A neighbour that ran out in known free space (a
+// door seen from its room's side) or started in unknown space does not count (session 26's rule let
+// one of them count).
 int passage_probes(std::span<const ProbeState> ring);
 
 class TopologicalFrontiers {

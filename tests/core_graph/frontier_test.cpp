@@ -514,7 +514,7 @@ TEST(TopologicalFrontiers, AFlightRisingOutOfTheReachableSetIsAFlightLead) {
 
 // GraphOptions::passage_frontiers: an open C_exp probe between two probes blocked by obstacles
 // (walls either side) is a passage; a neighbour that ran out in known free space, or started in
-// unknown space, is not a wall (session 28: counting those made the office slower).
+// unknown space, is not a wall (session 26's rule counted one of them).
 TEST(TopologicalFrontiers, APassageIsAnOpenProbeBetweenTwoBlockedOnes) {
   using P = ProbeState;
   const P o = P::kOpen, b = P::kBlocked, x = P::kOther;
