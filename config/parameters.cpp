@@ -188,6 +188,7 @@ void read_plan(SectionReader&& r, core::plan::PlanOptions& o) {
   r.get("brake_start", o.brake_start);
   r.get("reference_clock", o.reference_clock);
   r.get("reference_catch_up", o.reference_catch_up);
+  r.get("start_at_speed", o.start_at_speed);
   r.get("no_progress_s", o.no_progress_s, Range{0.0, 600.0});
   r.get("stale_floor_s", o.stale_floor_s, Range{0.0, 3600.0});
   r.get("replan_only_if_faster", o.replan_only_if_faster);

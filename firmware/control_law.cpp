@@ -82,6 +82,10 @@ bool ControlLaw::turns_away(const core::plan::BsplineTrajectory& t,
   const double look = v.squaredNorm() / std::max(robot_.max_accel_mps2, 1e-3) + 0.3;
   const Eigen::Vector2d u = v.normalized();
   const core::plan::TrajectorySample a = t.sample(t.t_start());
+  // One that leaves its start moving along v (plan.start_at_speed: planned from the robot's
+  // velocity) slows for its own bends within the limits: nothing to brake for.
+  const Eigen::Vector2d v0 = a.v_mps.head<2>();
+  if (v0.norm() > 0.05) return v0.normalized().dot(u) < 0.5;
   Eigen::Vector2d prev = a.p_m.head<2>();
   double walked = 0;
   for (double s = t.t_start() + 0.05;; s += 0.05) {

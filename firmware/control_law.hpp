@@ -52,7 +52,8 @@ class ControlLaw {
   // along the curve, whatever its timing), heads more than 60 deg off the robot's velocity v
   // (world frame), turns the body more than 0.5 rad, or ends: the robot brakes on the trajectory
   // it follows before it enters this one (plan.brake_start). One that carries on along v is
-  // entered at once (a stop at every replan would halve the speed).
+  // entered at once (a stop at every replan would halve the speed), and so is one that leaves
+  // its start moving within 60 deg of v (plan.start_at_speed): its profile slows for its bends.
   bool turns_away(const core::plan::BsplineTrajectory& t, const Eigen::Vector2d& v) const;
   // Clamps a command to speed / yaw-rate limits and rate-limits it against prev (exposed for
   // tests).

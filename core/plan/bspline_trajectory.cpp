@@ -169,7 +169,7 @@ double BsplineTrajectory::accel_bound_mps2() const {
 // at the start, each step taking the largest admissible |x'|, give the fastest x along sigma;
 // time follows from t' = 1 / sigma_dot.
 void BsplineTrajectory::retime(const RobotModel& robot, int samples_per_knot, double margin,
-                               double yaw_margin) {
+                               double yaw_margin, double start_speed_mps) {
   w_t_.clear();
   w_u_.clear();
   w_s_.clear();
@@ -256,7 +256,8 @@ void BsplineTrajectory::retime(const RobotModel& robot, int samples_per_knot, do
     mvc[k] = a;
   }
   // Backward pass (deceleration into the end's rest), then forward (acceleration from the
-  // start's). A step's x' is the tighter of its two ends' bounds.
+  // start's, or from start_speed_mps where the backward pass allows it). A step's x' is the
+  // tighter of its two ends' bounds.
   std::vector<double> x(size_t(K) + 1, 0.0);
   x[K] = 0;
   for (int k = K - 1; k >= 0; --k) {
@@ -271,7 +272,8 @@ void BsplineTrajectory::retime(const RobotModel& robot, int samples_per_knot, do
   double prev = 0;
   for (int k = 0; k <= K; ++k) {
     if (k == 0) {
-      x[0] = 0;
+      const double v0 = std::isfinite(start_speed_mps) ? std::max(0.0, start_speed_mps) : 0.0;
+      x[0] = moving[0] ? std::min(x[0], v0 * v0) : 0.0;
     } else {
       const double ds = w_s_[k] - w_s_[k - 1];
       double acc = admissible(k - 1, prev).second;
@@ -311,10 +313,22 @@ bool TrajectoryBuilder::segment_ok(const map::MapView& view, CollisionChecker& c
 
 BsplineTrajectory TrajectoryBuilder::fit(std::span<const Eigen::Vector3d> wp,
                                          std::span<const uint8_t> pinned, double yaw_start,
-                                         std::optional<double> yaw_goal, double t0) const {
+                                         std::optional<double> yaw_goal, double t0,
+                                         const Eigen::Vector2d& v0) const {
   std::vector<Eigen::Vector3d> c;
   const double spacing = std::max(opt_.control_spacing_m, 1e-2);
-  c.insert(c.end(), 3, wp[0]);
+  // Leaving at speed: P_0, P_1, P_2 = s - h u, s, s + h u put the curve's start on s with its
+  // tangent along u = v0 / |v0|. h is at most half the first control step, so the next control
+  // point lies beyond P_2 when the path carries on along u.
+  const double speed = v0.norm();
+  const bool at_speed = opt_.retime && wp.size() >= 2 && speed > 1e-3;
+  if (at_speed) {
+    const Eigen::Vector3d u(v0.x() / speed, v0.y() / speed, 0.0);
+    const double h = 0.5 * std::min(spacing, (wp[1] - wp[0]).head<2>().norm());
+    c = {wp[0] - h * u, wp[0], wp[0] + h * u};
+  } else {
+    c.insert(c.end(), 3, wp[0]);
+  }
   for (size_t k = 0; k + 1 < wp.size(); ++k) {
     const Eigen::Vector3d d = wp[k + 1] - wp[k];
     const int nseg = std::max(1, int(std::ceil(d.norm() / spacing)));
@@ -462,17 +476,19 @@ BsplineTrajectory TrajectoryBuilder::fit(std::span<const Eigen::Vector3d> wp,
   for (int q = 0; q + 2 < nc; ++q)
     dt = std::max(dt, std::sqrt(std::abs(y[q + 2] - 2 * y[q + 1] + y[q]) / wamax));
   BsplineTrajectory t(std::move(c), std::move(y), dt * (1 + 1e-9), t0);
-  if (opt_.retime) t.retime(robot_, 16, 0.97, opt_.retime_yaw_share);
+  if (opt_.retime) t.retime(robot_, 16, 0.97, opt_.retime_yaw_share, at_speed ? speed : 0.0);
   return t;
 }
 
 TrajectoryResult TrajectoryBuilder::build(const map::MapView& view, CollisionChecker& checker,
                                           std::span<const Eigen::Vector3d> path, double yaw_start,
-                                          std::optional<double> yaw_goal, double t0) {
+                                          std::optional<double> yaw_goal, double t0,
+                                          std::optional<Eigen::Vector2d> start_velocity) {
   TrajectoryResult r;
   if (path.empty() || !std::isfinite(yaw_start) || !std::isfinite(t0) ||
-      (yaw_goal && !std::isfinite(*yaw_goal)))
+      (yaw_goal && !std::isfinite(*yaw_goal)) || (start_velocity && !start_velocity->allFinite()))
     return r;
+  const Eigen::Vector2d v0 = start_velocity.value_or(Eigen::Vector2d::Zero());
   for (const auto& p : path)
     if (!p.allFinite()) return r;
 
@@ -519,6 +535,9 @@ TrajectoryResult TrajectoryBuilder::build(const map::MapView& view, CollisionChe
   // colliding (shortcut corners hug door frames, where the long body cannot turn), do the same
   // on the A* path itself, decimated to the control spacing (it keeps the soft clearance);
   // finally the pinned polyline.
+  auto start_speed = [](const BsplineTrajectory& t) {
+    return t.sample(t.t_start()).v_mps.head<2>().norm();
+  };
   auto check = [&](const BsplineTrajectory& t) {
     return checker.check_ahead(
         view, [&](double s) { return t.pose(s); }, t.t_start(), t.duration(), 0.0);
@@ -526,7 +545,8 @@ TrajectoryResult TrajectoryBuilder::build(const map::MapView& view, CollisionChe
   auto repair_loop = [&](const std::vector<Eigen::Vector3d>& w) {
     std::vector<uint8_t> pinned(w.size(), 0);
     for (int attempt = 0;; ++attempt) {
-      r.trajectory = fit(w, pinned, yaw_start, yaw_goal, t0);
+      r.trajectory = fit(w, pinned, yaw_start, yaw_goal, t0, v0);
+      r.start_speed_mps = start_speed(r.trajectory);
       r.hit = check(r.trajectory);
       if (!r.hit.collides) return true;
       if (attempt >= opt_.max_repairs) return false;
@@ -568,7 +588,8 @@ TrajectoryResult TrajectoryBuilder::build(const map::MapView& view, CollisionChe
     }
   }
   std::vector<uint8_t> all(wp.size(), 1);
-  r.trajectory = fit(wp, all, yaw_start, yaw_goal, t0);
+  r.trajectory = fit(wp, all, yaw_start, yaw_goal, t0, v0);
+  r.start_speed_mps = start_speed(r.trajectory);
   r.hit = check(r.trajectory);
   r.status = r.hit.collides ? TrajectoryStatus::kCollision : TrajectoryStatus::kPolyline;
   return r;

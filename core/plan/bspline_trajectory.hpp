@@ -6,7 +6,9 @@
 //    has support under it (a traversable surface within step height of the interpolated height,
 //    every half voxel) and the body box swept along it is collision-free (FCL).
 // 2. Control points: the pruned polyline densified to control_spacing_m, first and last point
-//    tripled (the curve starts and ends on them at rest). Yaw has its own control points (the
+//    tripled (the curve starts and ends on them at rest; or, given the robot's velocity, the
+//    start is P_1 with P_0, P_2 = P_1 -/+ h v / |v|: the curve leaves along v). Yaw has its own
+//    control points (the
 //    travel direction around each point, unwrapped; start = robot yaw, end = goal yaw if given).
 // 3. Timing: one knot interval dt for the whole spline, the smallest with
 //      |P_{i+1} - P_i|_xy / dt <= v_max,  |P_{i+2} - 2 P_{i+1} + P_i|_xy / dt^2 <= a_max,
@@ -73,8 +75,10 @@ class BsplineTrajectory {
   // ends and wherever the curve stops (a pinned vertex). Limits are used at `margin` of their
   // value (the profile is exact at the samples only).
   // yaw_margin: the same for the yaw-rate and yaw-acceleration limits.
+  // start_speed_mps: the speed the profile starts at (a curve leaving along the robot's velocity,
+  // TrajectoryBuilder::build), capped by what the curve and the limits allow there.
   void retime(const RobotModel& robot, int samples_per_knot = 16, double margin = 0.97,
-              double yaw_margin = 0.97);
+              double yaw_margin = 0.97, double start_speed_mps = 0.0);
   bool retimed() const { return !w_t_.empty(); }
 
  private:
@@ -135,6 +139,7 @@ struct TrajectoryResult {
   CollisionHit hit;                          // the last collision check
   int repairs = 0;
   uint32_t segment_checks = 0;  // shortcut segment tests
+  double start_speed_mps = 0;   // planar speed at t_start (0 unless started at speed)
 };
 
 class TrajectoryBuilder {
@@ -143,9 +148,13 @@ class TrajectoryBuilder {
       : robot_(robot), opt_(options) {}
 
   // path_m: support points from the voxel A* (start = the robot). yaw_goal: the viewpoint's yaw.
+  // start_velocity_mps (planar, world; with TrajectoryOptions::retime only): the curve leaves
+  // path_m[0] along it at its speed, or as near it as the curve's first bend allows
+  // (TrajectoryResult::start_speed_mps), instead of at rest.
   TrajectoryResult build(const map::MapView& view, CollisionChecker& checker,
                          std::span<const Eigen::Vector3d> path_m, double yaw_start_rad,
-                         std::optional<double> yaw_goal_rad, double t0_s);
+                         std::optional<double> yaw_goal_rad, double t0_s,
+                         std::optional<Eigen::Vector2d> start_velocity_mps = std::nullopt);
 
   // Shortcut test of one segment (support under it + body sweep), exposed for tests.
   bool segment_ok(const map::MapView& view, CollisionChecker& checker, const Eigen::Vector3d& a,
@@ -153,7 +162,8 @@ class TrajectoryBuilder {
 
  private:
   BsplineTrajectory fit(std::span<const Eigen::Vector3d> wp, std::span<const uint8_t> pinned,
-                        double yaw_start, std::optional<double> yaw_goal, double t0) const;
+                        double yaw_start, std::optional<double> yaw_goal, double t0,
+                        const Eigen::Vector2d& v0) const;
 
   RobotModel robot_;
   TrajectoryOptions opt_;

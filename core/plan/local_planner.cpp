@@ -448,8 +448,12 @@ void LocalPlanner::ensure_search_graph(const LocalPlanInput& in) {
 bool LocalPlanner::free_start(const LocalPlanInput& in) {
   start_foot_m_ = in.robot_foot_m;
   start_yaw_ = in.robot_yaw_rad;
+  start_velocity_.reset();
   BodyPose p{in.robot_foot_m, in.robot_yaw_rad, 0.0, in.t_s};
   const bool clear = !checker_.check_poses(*in.view, std::span<const BodyPose>(&p, 1)).collides;
+  if (clear && plan_opt_.start_at_speed && in.robot_velocity_mps.allFinite() &&
+      in.robot_velocity_mps.norm() > kAtSpeedMinMps)
+    start_velocity_ = in.robot_velocity_mps;
   if (clear && plan_opt_.brake_start) brake_start(in);
   if (clear) return true;
   constexpr int kDirs = 16;
@@ -1046,8 +1050,24 @@ bool LocalPlanner::try_target(const LocalPlanInput& in, const Viewpoint& vp, Loc
   // body with FCL whichever path it follows.
   path.points_m.front() = start_foot_m_;
   double goal_yaw = shape_path(*in.view, path.points_m, vp.yaw_rad);
-  TrajectoryResult tr =
-      builder_.build(*in.view, checker_, path.points_m, start_yaw_, goal_yaw, in.t_s);
+  // PlanOptions::start_at_speed: the same path from the robot's foot (before the braking start,
+  // if one was taken), leaving along its velocity; from rest where that curve is not clear or
+  // must slow below kAtSpeedShare of the speed at once (a bend at its very start).
+  auto build = [&](std::optional<double> yaw) {
+    if (start_velocity_) {
+      std::vector<Eigen::Vector3d> from_robot;
+      if ((path.points_m.front() - in.robot_foot_m).head<2>().norm() > 0.01)
+        from_robot.push_back(in.robot_foot_m);
+      from_robot.insert(from_robot.end(), path.points_m.begin(), path.points_m.end());
+      TrajectoryResult t = builder_.build(*in.view, checker_, from_robot, in.robot_yaw_rad, yaw,
+                                          in.t_s, *start_velocity_);
+      if (t.status == TrajectoryStatus::kOk &&
+          t.start_speed_mps >= kAtSpeedShare * start_velocity_->norm())
+        return t;
+    }
+    return builder_.build(*in.view, checker_, path.points_m, start_yaw_, yaw, in.t_s);
+  };
+  TrajectoryResult tr = build(goal_yaw);
   auto failed = [&]() {
     if (tr.hit.collides) last_hit_m_ = tr.hit.voxel_m.cast<float>();
     return tr.status != TrajectoryStatus::kOk && tr.status != TrajectoryStatus::kPolyline;
@@ -1058,7 +1078,7 @@ bool LocalPlanner::try_target(const LocalPlanInput& in, const Viewpoint& vp, Loc
     if (!plan_opt_.arrive_along_path || !tr.hit.collides ||
         (tr.hit.voxel_m - vp.p_m).head<2>().norm() > robot_.body_length_m)
       return false;
-    tr = builder_.build(*in.view, checker_, path.points_m, start_yaw_, std::nullopt, in.t_s);
+    tr = build(std::nullopt);
     if (failed()) return false;
     goal_yaw = tr.trajectory.pose(tr.trajectory.t_end()).yaw_rad;
     return true;
@@ -1066,7 +1086,7 @@ bool LocalPlanner::try_target(const LocalPlanInput& in, const Viewpoint& vp, Loc
   if (failed() && !along_path()) {
     if (on_graph || !graph_path()) return false;
     goal_yaw = shape_path(*in.view, path.points_m, vp.yaw_rad);
-    tr = builder_.build(*in.view, checker_, path.points_m, start_yaw_, goal_yaw, in.t_s);
+    tr = build(goal_yaw);
     if (failed() && !along_path()) return false;
   }
   out.trajectory = std::move(tr.trajectory);

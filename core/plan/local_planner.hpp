@@ -328,10 +328,16 @@ class LocalPlanner {
   uint32_t robot_node_ = 0xFFFFFFFFu;
   Eigen::Vector3d start_foot_m_ = Eigen::Vector3d::Zero();  // Stage 3 start (free_start())
   double start_yaw_ = 0;
+  // PlanOptions::start_at_speed: the robot's planar velocity when free_start() found it clear
+  // and moving (the curve may leave its foot at that speed), else none.
+  std::optional<Eigen::Vector2d> start_velocity_;
   std::vector<Eigen::Vector3d> start_nodes_m_;  // nearest confirmed nodes (blind-ring starts)
   // Current target.
   bool has_target_ = false;
   bool periodic_ = false;  // this plan() is a periodic replan (PlanOptions::replan_only_if_faster)
+  // PlanOptions::start_at_speed: slower robots start at rest; an at-speed curve must keep this
+  // share of the robot's speed at its start (else it starts at rest).
+  static constexpr double kAtSpeedMinMps = 0.2, kAtSpeedShare = 0.8;
   static constexpr double kFasterMarginS = 1.0;  // a new trajectory must arrive this much earlier
   int32_t target_cluster_ = -1;
   std::vector<Eigen::Vector3f> target_nodes_m_;  // the target cluster's frontier nodes

@@ -235,6 +235,52 @@ TEST(BsplineTrajectory, TurningInPlaceKeepsTheBodyLevel) {
   EXPECT_NEAR(u.pose(0.5 * (u.t_start() + u.t_end())).pitch_rad, 10 * M_PI / 180, 1e-6);
 }
 
+// TrajectoryBuilder::build with a start velocity (PlanOptions::start_at_speed): the curve leaves
+// its first point along the velocity at its speed, within every limit, and arrives sooner than
+// from rest. A velocity across the path's first leg: the curve still leaves along it, as fast as
+// the bend right after the start allows (below the robot's speed). Without re-timing the
+// velocity is ignored (one knot interval has no start speed to give).
+TEST(BsplineTrajectory, ACurveStartedAtSpeedLeavesAlongTheVelocity) {
+  const RobotModel robot;
+  map::TraversabilityMap empty;
+  CollisionChecker cc(robot, 0.1);
+  TrajectoryBuilder tb(robot, TrajectoryOptions{.retime = true});
+  const TrajectoryResult rest = tb.build(empty.view(), cc, kEll, 0.0, std::nullopt, 0.0);
+  const TrajectoryResult go =
+      tb.build(empty.view(), cc, kEll, 0.0, std::nullopt, 0.0, Eigen::Vector2d(0.8, 0.0));
+  ASSERT_EQ(go.status, TrajectoryStatus::kOk);
+  const BsplineTrajectory& t = go.trajectory;
+  const TrajectorySample s0 = t.sample(t.t_start());
+  EXPECT_NEAR((s0.p_m - kEll[0]).norm(), 0, 1e-9);
+  EXPECT_NEAR(s0.v_mps.x(), 0.8, 1e-3);
+  EXPECT_NEAR(s0.v_mps.y(), 0.0, 1e-6);
+  EXPECT_NEAR(go.start_speed_mps, 0.8, 1e-3);
+  EXPECT_NEAR(rest.start_speed_mps, 0.0, 1e-9);
+  expect_limits(t, robot, 0.02);
+  EXPECT_LT(t.duration(), rest.trajectory.duration() - 0.3);
+  EXPECT_NEAR((t.sample(t.t_end()).p_m - kEll.back()).norm(), 0, 1e-9);
+  EXPECT_NEAR(t.sample(t.t_end()).v_mps.norm(), 0, 1e-9);
+  for (double s = t.t_start() + 1e-3; s < t.t_start() + 1.0; s += 0.1) {
+    const Eigen::Vector3d fd = (t.sample(s + 1e-4).p_m - t.sample(s - 1e-4).p_m) / 2e-4;
+    EXPECT_NEAR((fd - t.sample(s).v_mps).norm(), 0, 0.02) << "t " << s;
+  }
+
+  const Eigen::Vector2d across(0.0, -0.8);
+  const TrajectoryResult bend =
+      tb.build(empty.view(), cc, kEll, -M_PI / 2, std::nullopt, 0.0, across);
+  ASSERT_EQ(bend.status, TrajectoryStatus::kOk);
+  const Eigen::Vector3d v0 = bend.trajectory.sample(0.0).v_mps;
+  EXPECT_GT(bend.start_speed_mps, 0.05);
+  EXPECT_LT(bend.start_speed_mps, 0.75);
+  EXPECT_NEAR(v0.head<2>().normalized().dot(across.normalized()), 1.0, 1e-6);
+  expect_limits(bend.trajectory, robot, 0.02);
+
+  TrajectoryBuilder uniform(robot);
+  const TrajectoryResult u =
+      uniform.build(empty.view(), cc, kEll, 0.0, std::nullopt, 0.0, Eigen::Vector2d(0.8, 0.0));
+  EXPECT_NEAR(u.start_speed_mps, 0.0, 1e-9);
+}
+
 TEST(BsplineTrajectory, BadInput) {
   map::TraversabilityMap empty;
   CollisionChecker cc(RobotModel{}, 0.1);
@@ -244,6 +290,8 @@ TEST(BsplineTrajectory, BadInput) {
             TrajectoryStatus::kBadInput);
   std::vector<Eigen::Vector3d> nan_path{{0, 0, 0}, {std::nan(""), 0, 0}};
   EXPECT_EQ(tb.build(empty.view(), cc, nan_path, 0, std::nullopt, 0).status,
+            TrajectoryStatus::kBadInput);
+  EXPECT_EQ(tb.build(empty.view(), cc, kEll, 0, std::nullopt, 0, Eigen::Vector2d(NAN, 0)).status,
             TrajectoryStatus::kBadInput);
   std::vector<Eigen::Vector3d> one{{1, 2, 0}};
   const TrajectoryResult r = tb.build(empty.view(), cc, one, 0, M_PI / 2, 0);  // turn in place

@@ -960,6 +960,40 @@ TEST(LocalPlanner, AMovingRobotsTrajectoryStartsWhereItComesToRest) {
   EXPECT_NEAR(still.head<2>().norm(), 0.0, 0.03) << still.transpose();
 }
 
+// PlanOptions::start_at_speed: the moving robot's new trajectory leaves its foot along its
+// velocity at its speed (not at rest where braking would end); a robot slower than
+// kAtSpeedMinMps, or heading into the wall 0.8 m away (the curve cannot keep 0.8 of the speed
+// before it must turn), starts at rest as with brake_start alone.
+TEST(LocalPlanner, AtSpeedAMovingRobotsTrajectoryLeavesWhereItIsAlongItsVelocity) {
+  auto plan = [](const Eigen::Vector3f& foot, const Eigen::Vector2d& v) {
+    Harness h;
+    const World w = corridor();
+    EXPECT_TRUE(scan_from(h, w, Eigen::Vector3f::Zero()));
+    PlanOptions po;
+    po.brake_start = true;
+    po.start_at_speed = true;
+    po.traj_retime = true;
+    LocalPlanner lp(RobotModel{}, po, 0.1);
+    const auto view = h.map.view();
+    LocalPlanInput in = input(h, view, foot, 0.0);
+    in.robot_velocity_mps = v;
+    const LocalPlanResult r = lp.plan(in);
+    EXPECT_EQ(r.status, LocalPlanStatus::kNewTrajectory) << r.replan_reason;
+    return r.status == LocalPlanStatus::kNewTrajectory ? r.trajectory.sample(r.trajectory.t_start())
+                                                       : TrajectorySample{};
+  };
+  const Eigen::Vector2d v(0.8, 0.0);
+  const TrajectorySample along = plan({-2, 0, 0}, v);  // 2 m before the viewpoint it plans to
+  EXPECT_NEAR((along.p_m.head<2>() - Eigen::Vector2d(-2, 0)).norm(), 0.0, 0.03)
+      << along.p_m.transpose();
+  EXPECT_NEAR((along.v_mps.head<2>() - v).norm(), 0.0, 0.02) << along.v_mps.transpose();
+  const TrajectorySample slow = plan({0, 0, 0}, {0.15, 0.0});
+  EXPECT_NEAR(slow.v_mps.norm(), 0.0, 1e-9);
+  const TrajectorySample wall = plan({0, 2.2f, 0}, {0.0, 1.0});
+  EXPECT_NEAR(wall.v_mps.norm(), 0.0, 1e-9);
+  EXPECT_NEAR(wall.p_m.y(), 2.2, 0.03) << wall.p_m.transpose();
+}
+
 // A climb found while other frontiers are left is deferred (the climb is one way): the robot
 // first visits the others and comes back to the flight. PlanOptions::stale_floor_s: once the
 // graph has not grown for that long, the climb is taken though frontiers remain (the teaching

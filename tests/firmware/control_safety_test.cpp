@@ -4,6 +4,7 @@
 #include <cmath>
 #include <vector>
 
+#include "core/map/traversability_map.hpp"
 #include "firmware/control_law.hpp"
 #include "firmware/safety_monitor.hpp"
 
@@ -187,6 +188,17 @@ TEST(ControlLaw, ANewTrajectoryThatBendsWithinTheRobotsReachIsBrakedInto) {
   EXPECT_TRUE(law.turns_away(retimed({{0, 0, 0}, {0.5, 0, 0}}), v));
   // Slow enough to fall in behind the reference within 0.6 m: the bend is out of reach.
   EXPECT_FALSE(law.turns_away(bend, {0.4, 0.0}));
+  // plan.start_at_speed: the same bend planned from the robot's velocity leaves its start at
+  // 0.97 m/s and slows for the bend itself: entered at once. Not by a robot walking north.
+  core::map::TraversabilityMap empty;
+  core::plan::CollisionChecker cc(robot, 0.1);
+  const std::vector<Eigen::Vector3d> path{{0, 0, 0}, {0.6, 0, 0}, {0.6, 3, 0}};
+  const core::plan::TrajectoryResult at_speed =
+      core::plan::TrajectoryBuilder(robot, {.retime = true})
+          .build(empty.view(), cc, path, 0.0, std::nullopt, 0.0, v);
+  ASSERT_GT(at_speed.start_speed_mps, 0.5);
+  EXPECT_FALSE(law.turns_away(at_speed.trajectory, v));
+  EXPECT_TRUE(law.turns_away(at_speed.trajectory, {0.0, 0.97}));
 }
 
 TEST(ControlLaw, FeedforwardInBodyFrameAndNanGuard) {
