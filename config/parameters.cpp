@@ -119,6 +119,7 @@ void read_graph(SectionReader&& r, core::graph::GraphOptions& o) {
   r.get("close_probes_at_holes", o.close_probes_at_holes);
   r.get("close_probes_at_wall_faces", o.close_probes_at_wall_faces);
   r.get("passage_frontiers", o.passage_frontiers);
+  r.get("ramp_frontiers", o.ramp_frontiers);
   r.get("keep_reachable_cut", o.keep_reachable_cut);
   r.get("relink_cuts", o.relink_cuts);
   r.get("relink_tries", o.relink_tries, Range{1, 1000});

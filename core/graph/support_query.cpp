@@ -275,6 +275,13 @@ bool SupportQuery::probe_open_climbing(const Eigen::Vector3f& foot, const Eigen:
   // on a 5 m flight sees only known treads within 3 m).
   // (GraphOptions::climb_frontiers; else length_m from the node).
   auto reach = [&] { return (opt_.climb_frontiers ? s_climb : 0.0f) + length_m; };
+  // GraphOptions::ramp_frontiers: an open probe whose support rose a step height in climbs
+  // flatter than a stair's (kStairGrade) climbed a ramp (a curb is no ramp).
+  float gradual = 0;
+  auto open_end = [&](bool open) {
+    if (open && climbed && opt_.ramp_frontiers && gradual >= step_) *climbed = true;
+    return open;
+  };
   for (int climb = 0; climb <= kMaxClimbs && s0 < reach(); ++climb) {
     const float s_end = reach();
     const Eigen::Vector3f from(foot.x() + dir.x() * s0, foot.y() + dir.y() * s0, zc + height_m);
@@ -282,7 +289,7 @@ bool SupportQuery::probe_open_climbing(const Eigen::Vector3f& foot, const Eigen:
     const ProbeSegment seg = probe_segment(from, to, need_free, &free_total, &unknown_run);
     if (blocked) *blocked = seg.hole;
     if (seg.closed) return false;
-    if (!seg.hit) return unknown_run >= need_unknown;
+    if (!seg.hit) return open_end(unknown_run >= need_unknown);
     const VoxelKey& hit = seg.hit_key;
     const float hx = (float(hit.x) + 0.5f) * vs_, hy = (float(hit.y) + 0.5f) * vs_;
     const float s_hit = (Eigen::Vector2f(hx, hy) - foot.head<2>()).dot(dir);
@@ -295,10 +302,10 @@ bool SupportQuery::probe_open_climbing(const Eigen::Vector3f& foot, const Eigen:
       // riser's top, N(v) < N_min): terrain not yet observed, what the probe looks for.
       // A stair's step: steeper than tan(25 deg) since the last climb (flights ~30 deg; a ramp,
       // 5-20 deg in buildings, keeps the ground ahead in the LiDAR's view: judged as level).
-      if (rise >= kStairGrade * std::max(s_hit - s_climb, vs_) && ++stair_steps >= kStairSteps &&
-          climbed)
-        *climbed = true;
-      if (top->state == TravState::kUnobserved) return free_total >= need_free;
+      const bool stair = rise >= kStairGrade * std::max(s_hit - s_climb, vs_);
+      if (stair && ++stair_steps >= kStairSteps && climbed) *climbed = true;
+      if (!stair) gradual += rise;
+      if (top->state == TravState::kUnobserved) return open_end(free_total >= need_free);
       if (leaves_reach && stair_steps >= kStairSteps && !top->reachable) *leaves_reach = true;
       zc = top->p_m.z();
       s_climb = s_hit;
@@ -309,7 +316,7 @@ bool SupportQuery::probe_open_climbing(const Eigen::Vector3f& foot, const Eigen:
     // Unknown right above the obstacle (within two voxels): terrain beyond a step not yet seen.
     for (int32_t dz = 1; dz <= 2; ++dz) {
       const Occupancy o = occupancy({hit.x, hit.y, hit.z + dz});
-      if (o == Occupancy::kUnknown) return free_total >= need_free;
+      if (o == Occupancy::kUnknown) return open_end(free_total >= need_free);
       if (o == Occupancy::kFree) break;
     }
     if (blocked) *blocked = true;

@@ -99,7 +99,9 @@ class SupportQuery {
   // reaching unobserved terrain (open). Otherwise as probe_open. Without this, a stair's risers
   // close every probe at body height up the flight and the stairs never become a frontier (paper
   // III-C: stairs are the way to the next floor). `climbed` (optional) tells whether an open
-  // probe had climbed two stair steps (each steeper than 25 deg) first: it runs up a flight.
+  // probe had climbed two stair steps (each steeper than 25 deg) first: it runs up a flight; or,
+  // with GraphOptions::ramp_frontiers, whether its support rose a step height on the way in
+  // climbs flatter than a stair's: it runs up a ramp.
   // *leaves_reach: the probe climbed a flight (two stair steps) onto support out of C_reach.
   // *blocked: a closed probe ended at an obstacle it could not climb or at a hole in a surface
   // (close_probes_at_holes): a wall.

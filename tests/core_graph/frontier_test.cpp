@@ -340,6 +340,44 @@ TEST(TopologicalFrontiers, ProbeOverACurbIsOpenButClimbsNoFlight) {
   EXPECT_TRUE(q.probe_open_climbing(Vector3f(-0.3f, 0, 0), Eigen::Vector2f(1, 0), 3.0f, 0.3f, 0.2f,
                                     0.3f, &climbed));
   EXPECT_FALSE(climbed);
+  // Nor a ramp (GraphOptions::ramp_frontiers): it rose more than a step, but at once, steeply.
+  o.ramp_frontiers = true;
+  SupportQuery qr(h.map.view(), o);
+  climbed = true;
+  EXPECT_TRUE(qr.probe_open_climbing(Vector3f(-0.3f, 0, 0), Eigen::Vector2f(1, 0), 3.0f, 0.3f, 0.2f,
+                                     0.3f, &climbed));
+  EXPECT_FALSE(climbed);
+}
+
+// GraphOptions::ramp_frontiers: a 10 deg ramp seen from its foot (sensor 0.55 m up) is seen as
+// far as it stays below the sensor; a probe up it climbs the observed surface into the unknown
+// beyond. It rose more than a step on the way: with ramp_frontiers it climbed (one such probe
+// satisfies C_exp, like a flight's); without, it is an open probe on level-judged ground.
+TEST(TopologicalFrontiers, ProbeUpARampClimbsItWithRampFrontiers) {
+  World w;
+  w.add({-3.2f, -2, -0.3f}, {0.0f, 2, 0.0f});              // floor before the ramp
+  w.stairs(0.0f, -0.75f, 0.75f, 0.0f, 60, 0.0176f, 0.1f);  // 10 deg, 6 m, up 1.06 m
+  w.add({0.0f, -0.87f, -0.3f}, {6.0f, -0.75f, 2.5f});      // side walls
+  w.add({0.0f, 0.75f, -0.3f}, {6.0f, 0.87f, 2.5f});
+  w.add({-3.2f, -2, 0}, {-3.0f, 2, 2.5f});  // a wall behind the robot
+  for (const bool ramps : {false, true}) {
+    GraphOptions o;
+    o.ramp_frontiers = ramps;
+    Harness h(o);
+    h.observe(w, Vector3f(-1.5f, 0, 0.55f), Vector3f(-1.5f, 0, 0), 150000, 7, 8.0f);
+    SupportQuery q(h.map.view(), o);
+    const Vector3f foot(0.5f, 0, 0.09f);
+    bool climbed = !ramps;
+    EXPECT_TRUE(
+        q.probe_open_climbing(foot, Eigen::Vector2f(1, 0), 3.0f, 0.3f, 0.2f, 0.3f, &climbed))
+        << "ramp_frontiers " << ramps;
+    EXPECT_EQ(climbed, ramps);
+    // Level ground toward the wall behind: closed; nothing climbed.
+    climbed = false;
+    EXPECT_FALSE(q.probe_open_climbing(Vector3f(-1.0f, 0, 0), Eigen::Vector2f(-1, 0), 3.0f, 0.3f,
+                                       0.2f, 0.3f, &climbed));
+    EXPECT_FALSE(climbed);
+  }
 }
 
 // A wall seen only at grazing angles keeps voxel-sized holes; behind them lies the wall's solid,
