@@ -925,20 +925,29 @@ TEST(LocalPlanner, WithFlightFootTheClimbOnBridgesATreadMissingFromTheMapOnTheFl
 // trajectory starts there where the way is clear (house seed 3, session 16: a new target behind
 // the robot, the body turned while overshooting its start into a railing), else where it stands.
 namespace {
-Eigen::Vector3d planned_start(bool brake, const Eigen::Vector3f& foot, const Eigen::Vector2d& v) {
+// The start of the trajectory planned for a robot at `foot` moving at v in the corridor.
+TrajectorySample planned_start(const PlanOptions& po, const Eigen::Vector3f& foot,
+                               const Eigen::Vector2d& v) {
   Harness h;
   const World w = corridor();
   EXPECT_TRUE(scan_from(h, w, Eigen::Vector3f::Zero()));
-  PlanOptions po;
-  po.brake_start = brake;
   LocalPlanner lp(RobotModel{}, po, 0.1);
   const auto view = h.map.view();
   LocalPlanInput in = input(h, view, foot, 0.0);
   in.robot_velocity_mps = v;
   const LocalPlanResult r = lp.plan(in);
   EXPECT_EQ(r.status, LocalPlanStatus::kNewTrajectory) << r.replan_reason;
-  if (r.status != LocalPlanStatus::kNewTrajectory) return Eigen::Vector3d::Constant(NAN);
-  return r.trajectory.pose(r.trajectory.t_start()).foot_m;
+  if (r.status != LocalPlanStatus::kNewTrajectory) {
+    TrajectorySample none;
+    none.p_m.setConstant(NAN);
+    return none;
+  }
+  return r.trajectory.sample(r.trajectory.t_start());
+}
+Eigen::Vector3d planned_start(bool brake, const Eigen::Vector3f& foot, const Eigen::Vector2d& v) {
+  PlanOptions po;
+  po.brake_start = brake;
+  return planned_start(po, foot, v).p_m;
 }
 }  // namespace
 
@@ -965,22 +974,12 @@ TEST(LocalPlanner, AMovingRobotsTrajectoryStartsWhereItComesToRest) {
 // kAtSpeedMinMps, or heading into the wall 0.8 m away (the curve cannot keep 0.8 of the speed
 // before it must turn), starts at rest as with brake_start alone.
 TEST(LocalPlanner, AtSpeedAMovingRobotsTrajectoryLeavesWhereItIsAlongItsVelocity) {
-  auto plan = [](const Eigen::Vector3f& foot, const Eigen::Vector2d& v) {
-    Harness h;
-    const World w = corridor();
-    EXPECT_TRUE(scan_from(h, w, Eigen::Vector3f::Zero()));
-    PlanOptions po;
-    po.brake_start = true;
-    po.start_at_speed = true;
-    po.traj_retime = true;
-    LocalPlanner lp(RobotModel{}, po, 0.1);
-    const auto view = h.map.view();
-    LocalPlanInput in = input(h, view, foot, 0.0);
-    in.robot_velocity_mps = v;
-    const LocalPlanResult r = lp.plan(in);
-    EXPECT_EQ(r.status, LocalPlanStatus::kNewTrajectory) << r.replan_reason;
-    return r.status == LocalPlanStatus::kNewTrajectory ? r.trajectory.sample(r.trajectory.t_start())
-                                                       : TrajectorySample{};
+  PlanOptions po;
+  po.brake_start = true;
+  po.start_at_speed = true;
+  po.traj_retime = true;
+  auto plan = [&](const Eigen::Vector3f& foot, const Eigen::Vector2d& v) {
+    return planned_start(po, foot, v);
   };
   const Eigen::Vector2d v(0.8, 0.0);
   const TrajectorySample along = plan({-2, 0, 0}, v);  // 2 m before the viewpoint it plans to
