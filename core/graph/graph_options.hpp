@@ -35,10 +35,11 @@ struct GraphOptions {
   // test_ramp's upper corridors were left unexplored.
   bool passage_frontiers = false;
   // Beyond the paper, off (graph.ramp_frontiers, session 29; acts with climb_frontiers): the
-  // flight rule for ramps: one open probe whose support rose a step height on the way satisfies
-  // C_exp. A ramp 1.5 m wide is one probe wide too (30 deg apart), and the graph's end on it, seen
-  // only from its foot, had one open probe up it (Theta_min = 2): test_ramp seed 4 with
-  // plan.start_at_speed was "complete" with the upper floor at 2.4 %.
+  // flight rule for ramps: one open probe whose support rose a step height on the way, in climbs
+  // flatter than a stair's (a curb is no ramp), satisfies C_exp. A ramp 1.5 m wide is one probe
+  // wide too (30 deg apart), and the graph's end on it, seen only from its foot, had one open probe
+  // up it (Theta_min = 2): test_ramp seed 4 with plan.start_at_speed was "complete" with the upper
+  // floor at 2.4 %.
   bool ramp_frontiers = false;
   double probe_length_m = 3.0;      // probe length for C_exp
   int cluster_capacity = 8;         // maximum frontier nodes per cluster

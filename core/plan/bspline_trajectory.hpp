@@ -8,8 +8,8 @@
 // 2. Control points: the pruned polyline densified to control_spacing_m, first and last point
 //    tripled (the curve starts and ends on them at rest; or, given the robot's velocity, the
 //    start is P_1 with P_0, P_2 = P_1 -/+ h v / |v|: the curve leaves along v). Yaw has its own
-//    control points (the
-//    travel direction around each point, unwrapped; start = robot yaw, end = goal yaw if given).
+//    control points (the travel direction around each point, unwrapped; start = robot yaw, end =
+//    goal yaw if given).
 // 3. Timing: one knot interval dt for the whole spline, the smallest with
 //      |P_{i+1} - P_i|_xy / dt <= v_max,  |P_{i+2} - 2 P_{i+1} + P_i|_xy / dt^2 <= a_max,
 //    and the same for yaw with the yaw-rate / yaw-acceleration limits. By the convex-hull
