@@ -154,6 +154,7 @@ void read_plan(SectionReader&& r, core::plan::PlanOptions& o) {
   r.get("hyp_discard_observations", o.hyp_discard_observations, Range{1, 1000});
   r.get("hyp_promote_radius_m", o.hyp_promote_radius_m, Range{0.01, 10.0});
   r.get("tsp_exact_max_n", o.tsp_exact_max_n, Range{1, 16});
+  r.get("tsp_max_clusters", o.tsp_max_clusters, Range{1, 1000});
   r.get("heading_via_viewpoint_yaw", o.heading_via_viewpoint_yaw);
   r.get("astar_max_expansions", o.astar_max_expansions, Range{100, 100000000});
   r.get("astar_reachable_only", o.astar_reachable_only);
@@ -182,6 +183,7 @@ void read_plan(SectionReader&& r, core::plan::PlanOptions& o) {
   r.get("target_momentum", o.target_momentum);
   r.get("path_retries", o.path_retries, Range{0, 10});
   r.get("arrive_along_path", o.arrive_along_path);
+  r.get("face_cluster", o.face_cluster);
   r.get("reach_off_graph", o.reach_off_graph);
   r.get("keep_on_failed_replan", o.keep_on_failed_replan);
   r.get("climb_axis_ahead_m", o.climb_axis_ahead_m, Range{0.0, 1.5});

@@ -6,9 +6,9 @@
 // hybrid graph for the centres the first could not reach (same result as a two-stage A* per
 // pair, 2 searches per row instead of 2 per pair). Zones no route reaches are left out and
 // reported. Bounded work: only the max_tsp_zones zones nearest the robot (two-stage cost) enter
-// the TSP, the rest wait for a later cycle (as the local layer's max_tsp_clusters): the local
-// layer only serves the first guidance_zones of the sequence, and a building-size prior holds
-// ~100 zones (one row = one Dijkstra over the whole hybrid graph). Execution toward a zone
+// the TSP, the rest wait for a later cycle (as the local layer's PlanOptions::tsp_max_clusters):
+// the local layer only serves the first guidance_zones of the sequence, and a building-size prior
+// holds ~100 zones (one row = one Dijkstra over the whole hybrid graph). Execution toward a zone
 // follows only the real prefix of its path (approach()).
 #include <algorithm>
 #include <cstdint>

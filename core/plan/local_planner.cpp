@@ -269,7 +269,7 @@ bool LocalPlanner::to_off_graph(const LocalPlanInput& in, std::vector<Candidate>
     SetAsideReason why = SetAsideReason::kAstarFailed;
     size_t k = 0;
     for (; k < vps.size() && attempts < opt_.max_stage3_attempts; ++k, ++attempts) {
-      if (!try_target(in, vps[k], out, &why)) continue;
+      if (!try_target(in, vps[k], out, &why, /*cluster_view=*/true)) continue;
       adopt_target(in, cluster, out);
       out.replan_reason =
           "off the graph: no path along G_real to the last frontiers, one on the map";
@@ -1010,7 +1010,7 @@ int LocalPlanner::other_targets(const LocalPlanInput& in, int32_t except_id) con
 }
 
 bool LocalPlanner::try_target(const LocalPlanInput& in, const Viewpoint& vp, LocalPlanResult& out,
-                              SetAsideReason* why) {
+                              SetAsideReason* why, bool cluster_view) {
   *why = SetAsideReason::kAstarFailed;
   last_hit_m_ = kNoHitM;
   ++out.astar_calls;
@@ -1049,7 +1049,15 @@ bool LocalPlanner::try_target(const LocalPlanInput& in, const Viewpoint& vp, Loc
   // the nearest collision-free pose, see free_start()). The B-spline is checked against the
   // body with FCL whichever path it follows.
   path.points_m.front() = start_foot_m_;
-  double goal_yaw = shape_path(*in.view, path.points_m, vp.yaw_rad);
+  // The goal yaw: the viewpoint's (facing the cluster), none with PlanOptions::face_cluster off
+  // for a cluster's viewpoint (the curve's own end yaw), a flight's axis if the path ends on one.
+  const bool free_yaw = cluster_view && !plan_opt_.face_cluster;
+  auto goal_of = [&]() -> std::optional<double> {
+    const double y = shape_path(*in.view, path.points_m,
+                                free_yaw ? std::numeric_limits<double>::quiet_NaN() : vp.yaw_rad);
+    return std::isfinite(y) ? std::optional<double>(y) : std::nullopt;
+  };
+  std::optional<double> goal_yaw = goal_of();
   // PlanOptions::start_at_speed: the same path from the robot's foot (before the braking start,
   // if one was taken), leaving along its velocity; from rest where that curve is not clear or
   // must slow below kAtSpeedShare of the speed at once (a bend at its very start).
@@ -1075,7 +1083,7 @@ bool LocalPlanner::try_target(const LocalPlanInput& in, const Viewpoint& vp, Loc
   // PlanOptions::arrive_along_path: the body hit something within a body length of the
   // viewpoint, turning to its heading: arrive facing along the path (the curve's own end yaw).
   auto along_path = [&]() {
-    if (!plan_opt_.arrive_along_path || !tr.hit.collides ||
+    if (!plan_opt_.arrive_along_path || !goal_yaw || !tr.hit.collides ||
         (tr.hit.voxel_m - vp.p_m).head<2>().norm() > robot_.body_length_m)
       return false;
     tr = build(std::nullopt);
@@ -1085,14 +1093,14 @@ bool LocalPlanner::try_target(const LocalPlanInput& in, const Viewpoint& vp, Loc
   };
   if (failed() && !along_path()) {
     if (on_graph || !graph_path()) return false;
-    goal_yaw = shape_path(*in.view, path.points_m, vp.yaw_rad);
+    goal_yaw = goal_of();
     tr = build(goal_yaw);
     if (failed() && !along_path()) return false;
   }
   out.trajectory = std::move(tr.trajectory);
   out.path_m = std::move(path.points_m);
   out.target_m = vp.p_m;
-  out.target_yaw_rad = goal_yaw;
+  out.target_yaw_rad = goal_yaw ? *goal_yaw : out.trajectory.pose(out.trajectory.t_end()).yaw_rad;
   out.real_until_s = out.trajectory.t_end();  // the local layer plans on G_real only
   return true;
 }
@@ -1463,12 +1471,13 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     out.status = LocalPlanStatus::kNoReachableTarget;
     return out;
   }
-  // The nearest clusters (by graph distance) enter the TSP; the rest wait for later cycles.
+  // The nearest clusters (by graph distance) enter the TSP (PlanOptions::tsp_max_clusters); the
+  // rest wait for later cycles.
   std::vector<size_t> idx(cands.size());
   for (size_t i = 0; i < idx.size(); ++i) idx[i] = i;
   std::stable_sort(idx.begin(), idx.end(),
                    [&](size_t a, size_t b) { return cand_dist[a] < cand_dist[b]; });
-  if (int(idx.size()) > opt_.max_tsp_clusters) idx.resize(size_t(opt_.max_tsp_clusters));
+  if (int(idx.size()) > plan_opt_.tsp_max_clusters) idx.resize(size_t(plan_opt_.tsp_max_clusters));
   std::vector<Candidate> sel;
   for (size_t i : idx) sel.push_back(cands[i]);
 
@@ -1556,7 +1565,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     SetAsideReason why = SetAsideReason::kAstarFailed;
     for (size_t k = 0; k < vps.size() && attempts < opt_.max_stage3_attempts && !ok;
          ++k, ++attempts)
-      ok = try_target(in, vps[k], out, &why);
+      ok = try_target(in, vps[k], out, &why, /*cluster_view=*/true);
     if (ok) {
       adopt_target(in, (*in.clusters)[c.cluster_index], out);
       return out;

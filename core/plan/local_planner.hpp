@@ -119,7 +119,6 @@ struct SetAsideEntry {
 uint16_t frontier_signature(const graph::GraphNode& n);
 
 struct LocalPlannerOptions {
-  int max_tsp_clusters = 12;     // nearest clusters (graph distance) entering Stage 1
   double replan_period_s = 4.0;  // re-optimise a kept target this often
   // A cluster's id changes with its nodes (the frontier recedes as the robot comes near: new
   // nodes, old ones no longer frontiers). A cluster with a frontier node this close to one of
@@ -275,8 +274,10 @@ class LocalPlanner {
   // turn where it stands.
   bool escape(const LocalPlanInput& in, LocalPlanResult& out,
               const Eigen::Vector3f* away_from = nullptr);
+  // cluster_view: vp is a frontier cluster's viewpoint, whose yaw PlanOptions::face_cluster off
+  // leaves free (a flight's foot or a vantage point keeps its yaw).
   bool try_target(const LocalPlanInput& in, const Viewpoint& vp, LocalPlanResult& out,
-                  SetAsideReason* why);
+                  SetAsideReason* why, bool cluster_view = false);
   // Clusters other than except_id with a frontier node not set aside.
   int other_targets(const LocalPlanInput& in, int32_t except_id) const;
   // Facing up a flight: straight up the flight's axis to the last support seen and

@@ -16,6 +16,10 @@ struct PlanOptions {
   double hyp_promote_radius_m = 0.5;  // support found this close to a hypothetical column
   // Stage 1 / global order: open-tour TSP (tsp.hpp).
   int tsp_exact_max_n = 12;  // Held-Karp up to this many nodes, heuristic beyond
+  // Stage 1 schedules the nearest this many clusters (graph distance), the rest wait for later
+  // cycles (bounded work: one Dijkstra per cluster). The paper's TSP takes every cluster on a
+  // floor without guidance (Sec. IV-D): a tour over the nearest few leaves dead ends behind.
+  int tsp_max_clusters = 12;
   // Stage 2: dpsi_m through the viewpoint's own yaw psi_m instead of travel direction only.
   bool heading_via_viewpoint_yaw = false;
   // Stage 3: voxel A* (voxel_astar.hpp).
@@ -66,6 +70,11 @@ struct PlanOptions {
   // test_ramp) is reached facing along the path instead. The heading is a preference (Eq. 6 prices
   // the turn); the LiDAR sees all round, so the frontier is observed from the viewpoint either way.
   bool arrive_along_path = false;
+  // Paper (Sec. III-C): a viewpoint's yaw faces its cluster's centroid and the robot arrives
+  // turned to it. Off (session 30): every viewpoint is reached facing along the path (the curve's
+  // own end yaw; a flight's axis on a flight): the LiDAR sees all round, so the turn at the end
+  // observes nothing more, and the next leg often turns back.
+  bool face_cluster = true;
   // Beyond the paper, on in config/default.yaml (session 26): before "complete", clusters with no
   // path along G_real are tried with Stage 3 on the map (voxel A*), which needs no graph (a graph
   // split at a door it did not link through: office seed 1). One that no trajectory reaches is set

@@ -1452,16 +1452,16 @@ struct ArriveRun {
   LocalPlanStatus status = LocalPlanStatus::kBadInput;
   Eigen::Vector3d end_m = Eigen::Vector3d::Zero();
   double end_yaw_rad = 0;
+  double duration_s = 0;
 };
 
-ArriveRun run_arrive(bool on) {
+// The cluster's one viewpoint at `at` facing `yaw` (default: in the gate, facing across).
+ArriveRun run_arrive(const PlanOptions& po, const Eigen::Vector3f& at = Eigen::Vector3f(3, 0, 0),
+                     double yaw = M_PI / 2) {
   const GateScene s;
-  // One viewpoint: in the gate, facing across.
-  const auto vps = s.viewpoint(Eigen::Vector3f(3, 0, 0), M_PI / 2);
+  const auto vps = s.viewpoint(at, yaw);
   ArriveRun run;
   if (vps.empty()) return run;
-  PlanOptions po;
-  po.arrive_along_path = on;
   LocalPlanner lp(RobotModel{}, po, 0.1);
   const auto view = s.h.map.view();
   LocalPlanInput in = input(s.h, view, Eigen::Vector3f(0, 0, 0), 0.0);
@@ -1474,8 +1474,15 @@ ArriveRun run_arrive(bool on) {
     const auto end = r.trajectory.pose(r.trajectory.t_end());
     run.end_m = end.foot_m;
     run.end_yaw_rad = end.yaw_rad;
+    run.duration_s = r.trajectory.duration();
   }
   return run;
+}
+
+PlanOptions arrive_along_path(bool on) {
+  PlanOptions po;
+  po.arrive_along_path = on;
+  return po;
 }
 
 // PlanOptions::keep_on_failed_replan. The robot walks toward a viewpoint 2.2 m down the
@@ -1533,10 +1540,57 @@ TEST(LocalPlanner,
 }
 
 TEST(LocalPlanner, AViewpointTheBodyCannotTurnToIsReachedFacingAlongThePathWithArriveAlongPath) {
-  const ArriveRun off = run_arrive(false);
+  const ArriveRun off = run_arrive(arrive_along_path(false));
   EXPECT_EQ(off.status, LocalPlanStatus::kNoReachableTarget);
-  const ArriveRun on = run_arrive(true);
+  const ArriveRun on = run_arrive(arrive_along_path(true));
   ASSERT_EQ(on.status, LocalPlanStatus::kNewTrajectory);
   EXPECT_LT((on.end_m - Eigen::Vector3d(3, 0, 0)).head<2>().norm(), 0.3);
   EXPECT_LT(std::abs(std::remainder(on.end_yaw_rad, 2 * M_PI)), 0.35);  // along the corridor
+}
+
+// PlanOptions::face_cluster. A viewpoint 2 m down the corridor facing back at the robot (its
+// cluster behind it, as Sec. III-C's yaw faces a centroid the robot has passed): on, the robot
+// walks there and turns round; off, it arrives facing along the corridor, a half turn sooner.
+TEST(LocalPlanner, AClustersViewpointIsReachedFacingAlongThePathWithFaceClusterOff) {
+  PlanOptions po;
+  po.face_cluster = true;
+  const ArriveRun on = run_arrive(po, Eigen::Vector3f(2, 0, 0), M_PI);
+  po.face_cluster = false;
+  const ArriveRun off = run_arrive(po, Eigen::Vector3f(2, 0, 0), M_PI);
+  ASSERT_EQ(on.status, LocalPlanStatus::kNewTrajectory);
+  ASSERT_EQ(off.status, LocalPlanStatus::kNewTrajectory);
+  EXPECT_LT((on.end_m - Eigen::Vector3d(2, 0, 0)).head<2>().norm(), 0.3);
+  EXPECT_LT((off.end_m - Eigen::Vector3d(2, 0, 0)).head<2>().norm(), 0.3);
+  EXPECT_GT(std::abs(std::remainder(on.end_yaw_rad, 2 * M_PI)), M_PI - 0.2);  // facing back
+  EXPECT_LT(std::abs(std::remainder(off.end_yaw_rad, 2 * M_PI)), 0.35);       // along the path
+  // A half turn at most 1 rad/s (0.8 of it in the re-timing) takes over 3 s.
+  EXPECT_LT(off.duration_s, on.duration_s - 2.0);
+}
+
+namespace {
+// PlanOptions::tsp_max_clusters: Stage 1 schedules only the nearest this many clusters (graph
+// distance from the robot); the rest wait for a later cycle. One scan of the corridor leaves
+// more clusters than the default 12 (its under-observed floor between the rings).
+size_t scheduled(int tsp_max_clusters, size_t* n_clusters) {
+  const World w = corridor();
+  Harness h;
+  EXPECT_TRUE(scan_from(h, w, Eigen::Vector3f(0, 0, 0)));
+  *n_clusters = h.clusters.clusters().size();
+  const auto view = h.map.view();
+  PlanOptions po;
+  po.tsp_max_clusters = tsp_max_clusters;
+  LocalPlanner lp(RobotModel{}, po, 0.1);
+  const LocalPlanResult r = lp.plan(input(h, view, Eigen::Vector3f(0, 1.5f, 0), 0.0));
+  EXPECT_EQ(r.status, LocalPlanStatus::kNewTrajectory) << r.replan_reason;
+  if (!r.cluster_order.empty()) EXPECT_EQ(r.target_cluster, r.cluster_order[0]);
+  return r.cluster_order.size();
+}
+}  // namespace
+
+TEST(LocalPlanner, StageOneSchedulesTheNearestTspMaxClusters) {
+  size_t n = 0;
+  ASSERT_EQ(scheduled(PlanOptions{}.tsp_max_clusters, &n), 12u);
+  ASSERT_GT(n, 12u);
+  EXPECT_EQ(scheduled(1000, &n), n);  // every cluster
+  EXPECT_EQ(scheduled(3, &n), 3u);
 }
