@@ -184,6 +184,7 @@ void read_plan(SectionReader&& r, core::plan::PlanOptions& o) {
   r.get("path_retries", o.path_retries, Range{0, 10});
   r.get("arrive_along_path", o.arrive_along_path);
   r.get("face_cluster", o.face_cluster);
+  r.get("floor_first", o.floor_first);
   r.get("reach_off_graph", o.reach_off_graph);
   r.get("keep_on_failed_replan", o.keep_on_failed_replan);
   r.get("climb_axis_ahead_m", o.climb_axis_ahead_m, Range{0.0, 1.5});

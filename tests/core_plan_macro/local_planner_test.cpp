@@ -1594,3 +1594,67 @@ TEST(LocalPlanner, StageOneSchedulesTheNearestTspMaxClusters) {
   EXPECT_EQ(scheduled(1000, &n), n);  // every cluster
   EXPECT_EQ(scheduled(3, &n), 3u);
 }
+
+// PlanOptions::floor_first. A 2.4 m corridor rising by 5 cm steps (7 deg, a ramp to the
+// graph) from x = 0 to a level 1.2 m up at x = 9.6, seen from the floor and from the upper level:
+// frontier clusters on both. On, Stage 1 schedules the robot's floor's clusters only while any
+// is left; off, both levels'.
+namespace {
+World ramp_corridor() {
+  World w;
+  w.add({-8, -1.2f, -0.2f}, {0, 1.2f, 0});
+  w.stairs(0.0f, -1.2f, 1.2f, 0.0f, 24, 0.05f, 0.4f);
+  w.add({9.6f, -1.2f, 1.0f}, {20, 1.2f, 1.2f});
+  w.add({-8, -1.4f, 0}, {20, -1.2f, 4.0f});
+  w.add({-8, 1.2f, 0}, {20, 1.4f, 4.0f});
+  return w;
+}
+
+// Stage 1's order with the robot on the floor at (-2, 0); without the floor's clusters if
+// drop_floor. *up: the ids of the clusters up the ramp or on the upper level (centroid > 0.6 m).
+std::vector<int32_t> floor_first_order(bool on, bool drop_floor, std::vector<int32_t>* up) {
+  Harness h;
+  const World w = ramp_corridor();
+  h.observe(w, {-2.0f, 0, 0}, 40000, 1);
+  h.observe(w, {4.0f, 0, 0.5f}, 40000, 2);
+  h.observe(w, {11.0f, 0, 1.2f}, 40000, 3);
+  std::vector<storey::core::graph::FrontierCluster> clusters;
+  up->clear();
+  for (const auto& c : h.clusters.clusters()) {
+    const bool is_up = c.centroid_m.z() > 0.6f;
+    if (drop_floor && !is_up) continue;
+    if (is_up) up->push_back(c.id);
+    clusters.push_back(c);
+  }
+  const auto view = h.map.view();
+  PlanOptions po;
+  po.floor_first = on;
+  LocalPlanner lp(RobotModel{}, po, 0.1);
+  LocalPlanInput in = input(h, view, Eigen::Vector3f(-2.0f, 0, 0), 0.0);
+  in.clusters = &clusters;
+  in.floor_z_m = 0.0;
+  const LocalPlanResult r = lp.plan(in);
+  EXPECT_EQ(r.status, LocalPlanStatus::kNewTrajectory) << r.replan_reason;
+  return r.cluster_order;
+}
+}  // namespace
+
+TEST(LocalPlanner, WithFloorFirstStageOneSchedulesTheRobotsFloorFirst) {
+  std::vector<int32_t> up;
+  auto n_up = [&](const std::vector<int32_t>& order) {
+    return std::count_if(order.begin(), order.end(), [&](int32_t id) {
+      return std::find(up.begin(), up.end(), id) != up.end();
+    });
+  };
+  const std::vector<int32_t> off = floor_first_order(false, false, &up);
+  ASSERT_GE(up.size(), 2u);
+  EXPECT_GT(n_up(off), 0);  // off: the upper level's clusters are scheduled with the floor's
+  const std::vector<int32_t> on = floor_first_order(true, false, &up);
+  ASSERT_FALSE(on.empty());
+  EXPECT_EQ(n_up(on), 0);  // on: the floor's only
+  EXPECT_LT(on.size(), off.size());
+  // No cluster left on the floor: the others are scheduled.
+  const std::vector<int32_t> rest = floor_first_order(true, true, &up);
+  EXPECT_EQ(size_t(n_up(rest)), up.size());
+  EXPECT_EQ(rest.size(), up.size());
+}
