@@ -192,7 +192,6 @@ ExplorationResult ExplorationPlanner::plan_cycle(const ExplorationInput& in) {
   li.robot_velocity_mps = in.robot_velocity_mps;
   li.t_s = in.t_s;
   li.trajectory_lag_s = in.trajectory_lag_s;
-  if (r.floor >= 0) li.floor_z_m = floors_.floor(r.floor).z_m;
   bool zones_left = false;
   // An escape or a climb under way is driven to its end before guidance picks a zone (a climb
   // onto a landing ends on the new floor, where the prior is built on arrival).

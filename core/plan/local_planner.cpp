@@ -1436,11 +1436,10 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   search_.dijkstra(sg_, std::span<const uint32_t>(&robot_node, 1));
   std::vector<Candidate> cands, off_graph;  // off_graph: no path along G_real
   std::vector<double> cand_dist;
-  // PlanOptions::floor_first: clusters off the robot's floor (up a ramp, on a landing) wait
-  // until the floor has no other, or its graph stopped growing.
+  // PlanOptions::floor_first: clusters off the robot's level (up a ramp, on a landing) wait until
+  // it has no other; once its graph stopped growing, they go first (the rest do not resolve).
   std::vector<Candidate> later;
   std::vector<double> later_dist;
-  const bool floor_first = plan_opt_.floor_first && in.floor_z_m && !stale;
   for (size_t ci = 0; ci < in.clusters->size(); ++ci) {
     const graph::FrontierCluster& c = (*in.clusters)[ci];
     uint32_t rep = graph::kNoId;
@@ -1462,8 +1461,8 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
       off_graph.push_back({c.id, ci, rep});
       continue;
     }
-    if (floor_first &&
-        std::abs(double(g.node(rep).p_m.z()) - *in.floor_z_m) > plan_opt_.floor_node_band_m) {
+    if (plan_opt_.floor_first &&
+        std::abs(double(g.node(rep).p_m.z()) - in.robot_foot_m.z()) > plan_opt_.floor_node_band_m) {
       later.push_back({c.id, ci, rep});
       later_dist.push_back(d);
       continue;
@@ -1471,7 +1470,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     cands.push_back({c.id, ci, rep});
     cand_dist.push_back(d);
   }
-  if (cands.empty()) cands.swap(later), cand_dist.swap(later_dist);
+  if (cands.empty() || (stale && !later.empty())) cands.swap(later), cand_dist.swap(later_dist);
   if (cands.empty()) {
     if (try_climb(true))
       return commit_climb("climb on: no reachable frontier, standing on a flight");

@@ -57,7 +57,6 @@ struct LocalPlanInput {
   double trajectory_lag_s = 0;
   Eigen::Vector2d robot_velocity_mps = Eigen::Vector2d::Zero();  // planar, world frame [m/s]
   std::optional<Eigen::Vector3d> anchor_m;  // c_anc from the macro layer (Stage 1 terminal)
-  std::optional<double> floor_z_m;          // the robot's floor's height (PlanOptions::floor_first)
   // The last call of a cycle, over every cluster: with nothing else left, clusters set aside for
   // a path failure may be retried from a new vantage point (PlanOptions::path_retries).
   bool last_resort = false;

@@ -75,12 +75,13 @@ struct PlanOptions {
   // own end yaw; a flight's axis on a flight): the LiDAR sees all round, so the turn at the end
   // observes nothing more, and the next leg often turns back.
   bool face_cluster = true;
-  // Beyond the paper, off (session 30): Stage 1 schedules the clusters on the robot's floor
-  // (representative within floor_node_band_m of its height) first; the others (up a ramp, on a
-  // landing, seen through a stairwell) once none is left or the graph stopped growing
-  // (stale_floor_s). The paper explores floor by floor (Table II), its prior projected from an
-  // explored reference floor; a ramp, unlike a flight, is no climb left for last, and the maze's
-  // robot walked up it with the ground floor half seen.
+  // Beyond the paper, off (session 30): Stage 1 schedules the clusters at the robot's level
+  // (representative within floor_node_band_m of its support height) first; the others (up a
+  // ramp, on a landing, seen through a stairwell) once none is left, and first once the graph
+  // stopped growing (stale_floor_s: what is left does not resolve). The paper explores floor by
+  // floor (Table II), its prior projected from an explored reference floor; a ramp, unlike a
+  // flight, is no climb left for last, and the maze's robot walked up it with the ground floor
+  // half seen.
   bool floor_first = false;
   // Beyond the paper, on in config/default.yaml (session 26): before "complete", clusters with no
   // path along G_real are tried with Stage 3 on the map (voxel A*), which needs no graph (a graph

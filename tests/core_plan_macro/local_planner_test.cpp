@@ -1612,7 +1612,8 @@ World ramp_corridor() {
 
 // Stage 1's order with the robot on the floor at (-2, 0); without the floor's clusters if
 // drop_floor. *up: the ids of the clusters up the ramp or on the upper level (centroid > 0.6 m).
-std::vector<int32_t> floor_first_order(bool on, bool drop_floor, std::vector<int32_t>* up) {
+std::vector<int32_t> floor_first_order(bool on, bool drop_floor, std::vector<int32_t>* up,
+                                       bool stale = false) {
   Harness h;
   const World w = ramp_corridor();
   h.observe(w, {-2.0f, 0, 0}, 40000, 1);
@@ -1629,11 +1630,15 @@ std::vector<int32_t> floor_first_order(bool on, bool drop_floor, std::vector<int
   const auto view = h.map.view();
   PlanOptions po;
   po.floor_first = on;
+  po.stale_floor_s = 5.0;
   LocalPlanner lp(RobotModel{}, po, 0.1);
   LocalPlanInput in = input(h, view, Eigen::Vector3f(-2.0f, 0, 0), 0.0);
   in.clusters = &clusters;
-  in.floor_z_m = 0.0;
-  const LocalPlanResult r = lp.plan(in);
+  LocalPlanResult r = lp.plan(in);
+  if (stale) {  // the graph has not grown for stale_floor_s: replanned then (periodic)
+    in.t_s = 6.0;
+    r = lp.plan(in);
+  }
   EXPECT_EQ(r.status, LocalPlanStatus::kNewTrajectory) << r.replan_reason;
   return r.cluster_order;
 }
@@ -1657,4 +1662,9 @@ TEST(LocalPlanner, WithFloorFirstStageOneSchedulesTheRobotsFloorFirst) {
   const std::vector<int32_t> rest = floor_first_order(true, true, &up);
   EXPECT_EQ(size_t(n_up(rest)), up.size());
   EXPECT_EQ(rest.size(), up.size());
+  // The graph stopped growing with the floor's clusters left (they do not resolve): the others
+  // go first, alone.
+  const std::vector<int32_t> stale = floor_first_order(true, false, &up, true);
+  ASSERT_FALSE(stale.empty());
+  EXPECT_EQ(size_t(n_up(stale)), stale.size());
 }
