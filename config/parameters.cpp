@@ -249,6 +249,7 @@ void read_safety(SectionReader&& r, SafetyConfig& o) {
   r.get("max_overruns", o.max_overruns, Range{1, 1000});
   r.get("turn_on_reference", o.turn_on_reference);
   r.get("lookahead_on_plan_grid", o.lookahead_on_plan_grid);
+  r.get("reference_yaw_gate_rad", o.reference_yaw_gate_rad, Range{0.05, 3.0});
 }
 
 void read_link(SectionReader&& r, LinkConfig& o) {

@@ -84,6 +84,9 @@ struct SafetyConfig {
   // replan on every new trajectory it finds colliding: sampled from tau, it failed a pose the
   // planner passed, and the robot stood stopped on a kept trajectory for 400 s (house seed 6).
   bool lookahead_on_plan_grid = false;
+  // The reference slows for a yaw error above this and waits from twice it
+  // (ControlLaw::progress_rate) [rad].
+  double reference_yaw_gate_rad = 0.6;
 };
 
 enum class LinkTransport { kDds, kUdp, kCan, kSim };

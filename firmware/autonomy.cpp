@@ -567,9 +567,8 @@ void Autonomy::control_step() {
     cmd = law_.track(ref, last_pose_, prev_cmd_, dt, entering_);
     // Progress along the curve only while tracking well: after a stop or a lag the reference
     // waits for the robot instead of running away from it.
-    const double yaw_err = std::abs(wrap_angle(ref.yaw_rad - last_pose_.yaw_rad));
-    const double rate =
-        std::clamp((0.6 - err) / 0.3, 0.0, 1.0) * std::clamp((1.2 - yaw_err) / 0.6, 0.0, 1.0);
+    const double rate = ControlLaw::progress_rate(err, wrap_angle(ref.yaw_rad - last_pose_.yaw_rad),
+                                                  opt_.params.safety.reference_yaw_gate_rad);
     if (tau_ < tau_end) lag_s_ += dt * (1.0 - rate * brake_k_);
     tau_ = std::min(tau_ + dt * rate * brake_k_, tau_end);
   } else if (has_traj && tau_ < tau_end) {

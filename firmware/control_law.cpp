@@ -127,4 +127,10 @@ double ControlLaw::catch_up_time(const core::plan::BsplineTrajectory& t, double 
   return d0 - best > kGainM ? best_s : tau;
 }
 
+double ControlLaw::progress_rate(double position_err_m, double yaw_err_rad, double yaw_gate_rad) {
+  const double g = std::max(yaw_gate_rad, 1e-3);
+  return std::clamp((0.6 - position_err_m) / 0.3, 0.0, 1.0) *
+         std::clamp((2.0 * g - std::abs(yaw_err_rad)) / g, 0.0, 1.0);
+}
+
 }  // namespace storey::firmware

@@ -55,6 +55,12 @@ class ControlLaw {
   // entered at once (a stop at every replan would halve the speed), and so is one that leaves
   // its start moving within 60 deg of v (plan.start_at_speed): its profile slows for its bends.
   bool turns_away(const core::plan::BsplineTrajectory& t, const Eigen::Vector2d& v) const;
+  // The rate [0, 1] at which the reference moves on along its curve while the robot tracks it
+  // with these planar position and yaw errors: 1 within 0.3 m and yaw_gate_rad, 0 from 0.6 m or
+  // twice yaw_gate_rad (linear between): after a stop or a lag the reference waits for the robot
+  // instead of running away from it. The body turned behind its reference sweeps poses FCL
+  // never checked (safety.reference_yaw_gate_rad).
+  static double progress_rate(double position_err_m, double yaw_err_rad, double yaw_gate_rad);
   // Clamps a command to speed / yaw-rate limits and rate-limits it against prev (exposed for
   // tests).
   VelocityCommand limit(VelocityCommand cmd, const VelocityCommand& prev, double dt_s) const;

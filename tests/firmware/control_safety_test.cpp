@@ -201,6 +201,22 @@ TEST(ControlLaw, ANewTrajectoryThatBendsWithinTheRobotsReachIsBrakedInto) {
   EXPECT_TRUE(law.turns_away(at_speed.trajectory, {0.0, 0.97}));
 }
 
+// safety.reference_yaw_gate_rad: the reference moves on at full rate within 0.3 m and the gate,
+// slows linearly, and waits from 0.6 m or twice the gate; either sign of the yaw error.
+TEST(ControlLaw, TheReferenceWaitsForABodyBehindItInPositionOrYaw) {
+  EXPECT_DOUBLE_EQ(ControlLaw::progress_rate(0.0, 0.0, 0.6), 1.0);
+  EXPECT_DOUBLE_EQ(ControlLaw::progress_rate(0.3, 0.6, 0.6), 1.0);
+  EXPECT_NEAR(ControlLaw::progress_rate(0.45, 0.0, 0.6), 0.5, 1e-12);
+  EXPECT_DOUBLE_EQ(ControlLaw::progress_rate(0.6, 0.0, 0.6), 0.0);
+  EXPECT_NEAR(ControlLaw::progress_rate(0.0, 0.9, 0.6), 0.5, 1e-12);
+  EXPECT_NEAR(ControlLaw::progress_rate(0.0, -0.9, 0.6), 0.5, 1e-12);
+  EXPECT_DOUBLE_EQ(ControlLaw::progress_rate(0.0, 1.2, 0.6), 0.0);
+  // A tighter gate: a body 34 deg behind (0.6 rad) holds the reference still.
+  EXPECT_NEAR(ControlLaw::progress_rate(0.0, 0.45, 0.3), 0.5, 1e-12);
+  EXPECT_DOUBLE_EQ(ControlLaw::progress_rate(0.0, 0.6, 0.3), 0.0);
+  EXPECT_NEAR(ControlLaw::progress_rate(0.45, 0.45, 0.3), 0.25, 1e-12);
+}
+
 TEST(ControlLaw, FeedforwardInBodyFrameAndNanGuard) {
   core::RobotModel robot;
   ControlLaw law(robot);
