@@ -1568,7 +1568,7 @@ TEST(LocalPlanner, AClustersViewpointIsReachedFacingAlongThePathWithFaceClusterO
 }
 
 namespace {
-// PlanOptions::tsp_max_clusters: Stage 1 schedules only the nearest this many clusters (graph
+// PlanOptions::tsp_max_clusters: Stage 1 schedules at most this many clusters, the nearest (graph
 // distance from the robot); the rest wait for a later cycle. One scan of the corridor leaves
 // more clusters than the default 12 (its under-observed floor between the rings).
 size_t scheduled(int tsp_max_clusters, size_t* n_clusters) {
@@ -1587,7 +1587,7 @@ size_t scheduled(int tsp_max_clusters, size_t* n_clusters) {
 }
 }  // namespace
 
-TEST(LocalPlanner, StageOneSchedulesTheNearestTspMaxClusters) {
+TEST(LocalPlanner, StageOneSchedulesAtMostTspMaxClusters) {
   size_t n = 0;
   ASSERT_EQ(scheduled(PlanOptions{}.tsp_max_clusters, &n), 12u);
   ASSERT_GT(n, 12u);
