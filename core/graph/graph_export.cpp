@@ -29,7 +29,9 @@ const char* state_name(ElementState s) {
 
 std::string to_json(const ReachableGraph& g, const std::vector<FrontierCluster>* clusters,
                     const std::vector<ClusterViewpoints>* viewpoints) {
-  std::string s = "{\n\"nodes\": [";
+  // The robot's node (-1: none): which component "reachable" is judged from.
+  std::string s = "{\n\"root\": ";
+  appendf(s, "%d,\n\"nodes\": [", g.root() == kNoId ? -1 : int(g.root()));
   bool first = true;
   for (NodeId i = 0; i < g.node_capacity(); ++i) {
     const GraphNode& n = g.node(i);

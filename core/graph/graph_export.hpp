@@ -1,7 +1,8 @@
 #pragma once
-// Export of G_real for pictures and the report: JSON (nodes with id, position, state, frontier
-// flags, cluster; edges with state, length, cost; clusters with centroids and viewpoints) and
-// an ASCII PLY of nodes (coloured by state / frontier) and edges. Not for real-time paths.
+// Export of G_real for pictures and the report: JSON (the robot's node; nodes with id, position,
+// state, frontier flags, cluster; edges with state, length, cost; clusters with centroids and
+// viewpoints) and an ASCII PLY of nodes (coloured by state / frontier) and edges. Not for real-time
+// paths.
 #include <string>
 #include <vector>
 

@@ -277,6 +277,7 @@ TEST(GraphExport, JsonAndPlyDescribeTheGraph) {
     ++states;
   EXPECT_EQ(states, h.graph.node_count() + h.graph.edge_count());
   EXPECT_NE(json.find("\"clusters\": ["), std::string::npos);
+  EXPECT_NE(json.find("\"root\": " + std::to_string(h.graph.root()) + ","), std::string::npos);
   EXPECT_NE(json.find("\"c_sur\": true"), std::string::npos);
   const std::string ply = to_ply(h.graph);
   EXPECT_NE(ply.find("element vertex " + std::to_string(h.graph.node_count()) + "\n"),
