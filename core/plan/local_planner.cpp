@@ -269,7 +269,7 @@ bool LocalPlanner::to_off_graph(const LocalPlanInput& in, std::vector<Candidate>
     SetAsideReason why = SetAsideReason::kAstarFailed;
     size_t k = 0;
     for (; k < vps.size() && attempts < opt_.max_stage3_attempts; ++k, ++attempts) {
-      if (!try_target(in, vps[k], out, &why, /*cluster_view=*/true)) continue;
+      if (!try_target(in, vps[k], out, &why, Goal::kClusterView)) continue;
       adopt_target(in, cluster, out);
       out.replan_reason =
           "off the graph: no path along G_real to the last frontiers, one on the map";
@@ -604,7 +604,8 @@ bool LocalPlanner::to_foot_of(const LocalPlanInput& in, const FlightFoot& f, Loc
     // map, or a trip across the building past its expansion limit).
     const graph::NodeId n = linked_node_near(*in.graph, q, 0.75f, 0.3f);
     SetAsideReason why = SetAsideReason::kAstarFailed;
-    if (try_target(in, Viewpoint{q.cast<double>(), f.yaw_rad, n}, out, &why)) return true;
+    if (try_target(in, Viewpoint{q.cast<double>(), f.yaw_rad, n}, out, &why, Goal::kFlightFoot))
+      return true;
   }
   return false;
 }
@@ -1010,7 +1011,7 @@ int LocalPlanner::other_targets(const LocalPlanInput& in, int32_t except_id) con
 }
 
 bool LocalPlanner::try_target(const LocalPlanInput& in, const Viewpoint& vp, LocalPlanResult& out,
-                              SetAsideReason* why, bool cluster_view) {
+                              SetAsideReason* why, Goal goal) {
   *why = SetAsideReason::kAstarFailed;
   last_hit_m_ = kNoHitM;
   ++out.astar_calls;
@@ -1045,13 +1046,29 @@ bool LocalPlanner::try_target(const LocalPlanInput& in, const Viewpoint& vp, Loc
   if (path.status != VoxelAStarStatus::kOk) on_graph = graph_path();
   if (path.status != VoxelAStarStatus::kOk || path.points_m.empty()) return false;
   *why = SetAsideReason::kTrajectoryFailed;
+  // A flight's foot: onto its axis from where the search stopped (within astar_goal_tolerance_m;
+  // house seed 5 with a 0.3 rad yaw gate stood 0.21 m beside the axis, the climb from there failed
+  // and the flight was never tried again), no nearer the first riser than the search came (the
+  // body's front over the riser pitches it). Without that step if the body meets something.
+  const Eigen::Vector2d axis(std::cos(vp.yaw_rad), std::sin(vp.yaw_rad));
+  const Eigen::Vector2d off = (path.points_m.back() - vp.p_m).head<2>();
+  const double beside = std::abs(off.x() * axis.y() - off.y() * axis.x());
+  const bool to_foot = goal == Goal::kFlightFoot && beside > 0.05;
+  std::vector<Eigen::Vector3d> short_of_foot;
+  if (to_foot) {
+    short_of_foot = path.points_m;
+    short_of_foot.front() = start_foot_m_;
+    Eigen::Vector3d on_axis = vp.p_m;
+    on_axis.head<2>() += std::min(0.0, off.dot(axis)) * axis;
+    path.points_m.push_back(on_axis);
+  }
   // The path starts at the robot's support voxel; start the curve at the robot itself (or at
   // the nearest collision-free pose, see free_start()). The B-spline is checked against the
   // body with FCL whichever path it follows.
   path.points_m.front() = start_foot_m_;
   // The goal yaw: the viewpoint's (facing the cluster), none with PlanOptions::face_cluster off
   // for a cluster's viewpoint (the curve's own end yaw), a flight's axis if the path ends on one.
-  const bool free_yaw = cluster_view && !plan_opt_.face_cluster;
+  const bool free_yaw = goal == Goal::kClusterView && !plan_opt_.face_cluster;
   auto goal_of = [&]() -> std::optional<double> {
     const double y = shape_path(*in.view, path.points_m,
                                 free_yaw ? std::numeric_limits<double>::quiet_NaN() : vp.yaw_rad);
@@ -1091,6 +1108,11 @@ bool LocalPlanner::try_target(const LocalPlanInput& in, const Viewpoint& vp, Loc
     goal_yaw = tr.trajectory.pose(tr.trajectory.t_end()).yaw_rad;
     return true;
   };
+  if (to_foot && failed()) {
+    path.points_m = std::move(short_of_foot);
+    goal_yaw = goal_of();
+    tr = build(goal_yaw);
+  }
   if (failed() && !along_path()) {
     if (on_graph || !graph_path()) return false;
     goal_yaw = goal_of();
@@ -1358,9 +1380,9 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
       }
     }
     SetAsideReason why = SetAsideReason::kAstarFailed;
-    const bool ok =
-        free_start(in) && ((d.flight && to_foot_of(in, *d.flight, out)) ||
-                           try_target(in, Viewpoint{d.foot_m, d.yaw_rad, graph::kNoId}, out, &why));
+    const bool ok = free_start(in) && ((d.flight && to_foot_of(in, *d.flight, out)) ||
+                                       try_target(in, Viewpoint{d.foot_m, d.yaw_rad, graph::kNoId},
+                                                  out, &why, Goal::kFlightFoot));
     if (!ok) {  // tried again next cycle (a B-spline through a door may fit from elsewhere)
       const int limit = plan_opt_.flight_foot ? opt_.max_climb_return_failures : 1;
       if (++deferred_climb_->failures >= limit) {
@@ -1576,7 +1598,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     SetAsideReason why = SetAsideReason::kAstarFailed;
     for (size_t k = 0; k < vps.size() && attempts < opt_.max_stage3_attempts && !ok;
          ++k, ++attempts)
-      ok = try_target(in, vps[k], out, &why, /*cluster_view=*/true);
+      ok = try_target(in, vps[k], out, &why, Goal::kClusterView);
     if (ok) {
       adopt_target(in, (*in.clusters)[c.cluster_index], out);
       return out;

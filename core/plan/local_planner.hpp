@@ -274,10 +274,12 @@ class LocalPlanner {
   // turn where it stands.
   bool escape(const LocalPlanInput& in, LocalPlanResult& out,
               const Eigen::Vector3f* away_from = nullptr);
-  // cluster_view: vp is a frontier cluster's viewpoint, whose yaw PlanOptions::face_cluster off
-  // leaves free (a flight's foot or a vantage point keeps its yaw).
+  // What a try_target goal is: a frontier cluster's viewpoint (its yaw left free with
+  // PlanOptions::face_cluster off), a pose (a retry's vantage point), or a flight's foot (the
+  // path ends on it, not within the voxel A*'s goal tolerance of it: a climb starts there).
+  enum class Goal { kClusterView, kPose, kFlightFoot };
   bool try_target(const LocalPlanInput& in, const Viewpoint& vp, LocalPlanResult& out,
-                  SetAsideReason* why, bool cluster_view = false);
+                  SetAsideReason* why, Goal goal = Goal::kPose);
   // Clusters other than except_id with a frontier node not set aside.
   int other_targets(const LocalPlanInput& in, int32_t except_id) const;
   // Facing up a flight: straight up the flight's axis to the last support seen and

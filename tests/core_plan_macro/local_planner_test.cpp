@@ -452,6 +452,7 @@ struct FootRun {
   bool to_foot = false;  // a new trajectory with the flight's-foot reason
   Eigen::Vector3d foot_m = Eigen::Vector3d::Zero();
   double foot_yaw = 0;
+  Eigen::Vector3d walk_end_m = Eigen::Vector3d::Zero();  // where the trajectory to the foot ends
   bool climbed = false;  // then a climb ending more than three treads up
 };
 
@@ -476,6 +477,7 @@ FootRun run_flight_foot(bool on) {
       run.to_foot = true;
       run.foot_m = r->target_m;
       run.foot_yaw = r->target_yaw_rad;
+      run.walk_end_m = r->trajectory.pose(r->trajectory.t_end()).foot_m;
     }
     if (reason.rfind("climb on", 0) == 0 && foot.z() > 0.5f) run.climbed = true;
   }
@@ -490,6 +492,9 @@ TEST(LocalPlanner, AFrontierBesideAFlightSendsTheRobotToTheFlightsFootToClimb) {
   EXPECT_GE(on.foot_m.x(), -1.5) << on.foot_m.transpose();         // before the first riser
   EXPECT_LE(on.foot_m.x(), -0.4) << on.foot_m.transpose();
   EXPECT_NEAR(on.foot_yaw, 0.0, 0.15);  // facing up the flight
+  // The walk ends on the flight's axis, not within the voxel search's goal tolerance of the foot.
+  EXPECT_NEAR(on.walk_end_m.y(), on.foot_m.y(), 0.05)
+      << on.walk_end_m.transpose() << " vs " << on.foot_m.transpose();
   EXPECT_TRUE(on.climbed);
   EXPECT_FALSE(run_flight_foot(false).to_foot);
 }
