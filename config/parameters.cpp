@@ -84,6 +84,7 @@ void read_map(SectionReader&& r, core::map::MapOptions& o) {
   r.get("n_min", o.n_min, Range{1, 1000});
   r.get("spill_is_surface", o.spill_is_surface);
   r.get("miss_needs_crossing", o.miss_needs_crossing);
+  r.get("floor_seen_from_above", o.floor_seen_from_above);
   r.get("neighbourhood_radius_m", o.neighbourhood_radius_m, Range{0.01, 5.0});
   r.get("neighbourhood_dz_m", o.neighbourhood_dz_m, Range{0.0, 2.0});
   r.get("n_ref", o.n_ref, Range{1, 100000});

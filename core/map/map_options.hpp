@@ -22,6 +22,14 @@ struct MapOptions {
   // afar; C_exp probes then left through them and frontiers came and went with the robot's
   // distance (test_ramp seed 1, session 22).
   bool miss_needs_crossing = false;
+  // Beyond the paper, off in config/default.yaml (map.floor_seen_from_above, session 31: on, house
+  // seed 1's path changed and met a body collision): a top surface needs a point seen from above it
+  // (a ray rising less steeply than the surface's slope). A ceiling seen from the floor below, its
+  // slab's inside never observed, read as a floor over the whole building (teaching_building seed
+  // 1 with a 0.3 rad yaw gate: 1,473 graph nodes on the 3.0 m underside of the 3.2 m floor, every
+  // cluster there unreachable, and "complete" on the upper floor at 2.5 %). A step edge (a riser's
+  // top seen from below, the tread behind it inferred) is exempt.
+  bool floor_seen_from_above = false;
   // --- occupancy (ray casting) ---
   double voxel_size_m = 0.1;    // map resolution
   double max_range_m = 30.0;    // rays beyond this are truncated (free space only, no endpoint)

@@ -225,7 +225,13 @@ TravState TraversabilityMap::evaluate(const VoxelKey& k, VoxelStats* s) {
       return TravState::kUnobserved;
     }
     const Eigen::Vector3d nrm = es.eigenvectors().col(0);
-    const double slope = std::acos(std::min(1.0, std::abs(nrm.z())));             // s(v), Eq. 1
+    const double slope = std::acos(std::min(1.0, std::abs(nrm.z())));  // s(v), Eq. 1
+    // MapOptions::floor_seen_from_above: every ray that hit v rose more steeply than the surface
+    // (+0.02 for noise): its underside (a ceiling), whatever lies unseen above it.
+    if (opt_.floor_seen_from_above && s->min_rise >= 100.0 * std::tan(slope) + 2.0) {
+      s->reasons = VoxelStats::kReasonNotTop;
+      return TravState::kUntraversable;
+    }
     const double rough = 1.0 - (ev[1] - ev[0]) / std::max(1e-18, ev[1] + ev[0]);  // r(v), Eq. 1
     const double under = 1.0 - std::min(1.0, n_agg / double(opt_.n_ref));         // u(v)
     // Eq. 2 with s_bar = s / max_slope, r_bar = r, u_bar = u (all 1 at their limits).

@@ -136,6 +136,20 @@ InsertStats TraversabilityMap::insert_scan(const Eigen::Vector3f& o,
     VoxelStats& vs = b->stats[c.stats];
     vs.add(float(p.x() - (k.x + 0.5) * s), float(p.y() - (k.y + 0.5) * s),
            float(p.z() - (k.z + 0.5) * s));
+    {
+      const float run = std::max(std::hypot(p.x() - o.x(), p.y() - o.y()), 1e-3f);
+      const int rise =
+          int(std::lround(std::clamp(100.0f * (p.z() - o.z()) / run, -127.0f, 127.0f)));
+      // Re-judged when it drops below 0.02 (seen from above whatever the surface's slope) or by
+      // 0.05 above that (a slope's threshold passed); below 0.02 nothing changes any more. (Only
+      // on doubling N(v), a floor grazed from the flight below and then from the top of the
+      // flight stayed S_untrav: the teaching building's upper floor was left.)
+      if (rise < vs.min_rise) {
+        if (opt_.floor_seen_from_above && vs.min_rise >= 2 && (rise < 2 || rise <= vs.min_rise - 5))
+          mark_changed(k, c);
+        vs.min_rise = int8_t(rise);
+      }
+    }
     // Re-evaluate tau(v) when N(v) reaches N_min or doubles since the last evaluation: the
     // statistics of a well-observed voxel barely move, so re-running Eq. 1-3 on every point
     // would cost without changing the state.

@@ -69,8 +69,13 @@ struct VoxelStats {
   uint8_t reasons = 0;  // why tau(v) is not S_trav: kReason* bits (diagnostics, export)
   uint8_t shape = 0;    // kStepEdge: set before tau(v) from v's points, the voxel above and
                         // the neighbours' means (TraversabilityMap::step_edge)
+  // The lowest rise of the rays that hit v, (z_point - z_sensor) / horizontal distance, in
+  // hundredths (clamped to +-127): a surface is seen from above only by a ray rising less than
+  // its own slope (MapOptions::floor_seen_from_above). In the padding: no larger.
+  int8_t min_rise = 127;
 
-  static constexpr uint8_t kReasonNotTop = 1;      // voxel above is occupied (not a surface)
+  static constexpr uint8_t kReasonNotTop = 1;  // voxel above is occupied, or v was seen only from
+                                               // below (floor_seen_from_above): not a surface
   static constexpr uint8_t kReasonDegenerate = 2;  // neighbourhood points are collinear
   static constexpr uint8_t kReasonCost = 4;        // c(v) > tau_c
   static constexpr uint8_t kReasonCollision = 8;   // R_col(v)

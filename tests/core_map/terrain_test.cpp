@@ -19,11 +19,12 @@ namespace {
 constexpr float kDeg = float(M_PI) / 180.f;
 
 void survey(TraversabilityMap& m, const World& w, const std::vector<Vector3f>& origins,
-            const Vector3f& foot, int scans = 2, int rays = 60000) {
+            const Vector3f& foot, int scans = 2, int rays = 60000, float el_max = 0.6f,
+            float sigma = 0.003f) {
   uint32_t seed = 1;
   for (const Vector3f& o : origins)
     for (int i = 0; i < scans; ++i) {
-      m.insert_scan(o, storey::test::scan_dense(w, o, rays, seed++));
+      m.insert_scan(o, storey::test::scan_dense(w, o, rays, seed++, -1.2f, el_max, 30.f, sigma));
       m.update_traversability();
       m.update_reachable(foot);
     }
@@ -331,13 +332,7 @@ TEST(Terrain, FloorOnAVoxelBoundaryIsNotUnderObservedWhereItSpills) {
     MapOptions opt;
     opt.spill_is_surface = on;
     TraversabilityMap m(opt);
-    uint32_t seed = 1;
-    for (const Vector3f& o : ring_of_origins(0.55f))
-      for (int i = 0; i < 2; ++i) {
-        m.insert_scan(o, storey::test::scan_dense(w, o, 60000, seed++, -1.2f, 0.6f, 30.f, 0.01f));
-        m.update_traversability();
-        m.update_reachable(Vector3f(0, 0, 0));
-      }
+    survey(m, w, ring_of_origins(0.55f), Vector3f(0, 0, 0), 2, 60000, 0.6f, 0.01f);
     const MapView v = m.view();
     BlockReader r(v.store());
     int spills = 0, spills_trav = 0, sparse = 0, sparse_unobserved = 0;
@@ -361,4 +356,86 @@ TEST(Terrain, FloorOnAVoxelBoundaryIsNotUnderObservedWhereItSpills) {
     EXPECT_GT(sparse, 0);
     EXPECT_EQ(sparse_unobserved, sparse);
   }
+}
+
+// A ceiling seen from the floor below: its slab's inside and the floor on top are never observed,
+// so the underside's voxels have no occupied voxel above them. Without a point seen from above
+// they read as a top surface: a phantom floor under the real one (teaching_building seed 1: over
+// the whole building, every frontier on it unreachable). With MapOptions::floor_seen_from_above
+// the underside is no floor; the slab's top, once seen from above, is.
+TEST(Terrain, ACeilingSeenFromBelowIsNoFloorUntilSeenFromAbove) {
+  World w;
+  w.add(aabb({-6, -6, -0.3f}, {6, 6, 0.0f}));  // floor
+  w.add(aabb({-6, -6, 3.0f}, {6, 6, 3.2f}));   // the slab: ceiling at 3.0, the next floor at 3.2
+  const auto underside = [](float, float) { return 3.0f; };
+  const auto top = [](float, float) { return 3.2f; };
+  for (const bool on : {true, false}) {
+    SCOPED_TRACE(on ? "map.floor_seen_from_above on" : "off");
+    MapOptions opt;
+    opt.spill_is_surface = opt.miss_needs_crossing = true;  // as in config/default.yaml
+    opt.floor_seen_from_above = on;
+    TraversabilityMap m(opt);
+    survey(m, w, ring_of_origins(0.55f), Vector3f(0, 0, 0), 2, 60000, 1.2f, 0.01f);
+    const Tally floor = tally(m, -2, 2, -2, 2, [](float, float) { return 0.0f; });
+    EXPECT_GE(floor.trav, floor.samples * 9 / 10) << floor.str();  // the floor stays a floor
+    const Tally below = tally(m, -2, 2, -2, 2, underside);
+    EXPECT_GE(below.found, below.samples * 9 / 10) << below.str();
+    if (on)
+      EXPECT_EQ(below.trav, 0) << below.str();
+    else
+      EXPECT_GE(below.trav, below.samples / 2) << below.str();  // the phantom floor
+    // Then seen from above (a robot on the slab, through no opening: its scans see its top).
+    World upper;
+    upper.add(aabb({-6, -6, 3.0f}, {6, 6, 3.2f}));
+    survey(m, upper, ring_of_origins(3.75f), Vector3f(0, 0, 3.2f), 2, 60000, 0.6f, 0.01f);
+    const Tally above = tally(m, -2, 2, -2, 2, top);
+    EXPECT_GE(above.trav, above.samples * 9 / 10) << above.str();
+  }
+}
+
+// A ramp rising above the sensor, seen from its foot only: its rays rise, but less steeply than
+// the ramp, and hit its top. It stays a floor with MapOptions::floor_seen_from_above (a test of
+// the sensor's height alone would drop it: here all of it past x = 2.1 m).
+TEST(Terrain, ARampRisingAboveTheSensorIsAFloorSeenFromItsFoot) {
+  World w = floor_world(10.f);
+  const float a = 25 * kDeg;
+  w.add(storey::test::ramp(1.0f, -1.0f, 1.0f, 0.03f, 4.0f, a));
+  const auto ramp_z = [a](float x, float) { return 0.03f + (x - 1.0f) * std::tan(a); };
+  int trav[2] = {0, 0};
+  for (const bool on : {true, false}) {
+    SCOPED_TRACE(on ? "map.floor_seen_from_above on" : "off");
+    MapOptions opt;
+    opt.spill_is_surface = opt.miss_needs_crossing = true;
+    opt.floor_seen_from_above = on;
+    TraversabilityMap m(opt);
+    survey(m, w, {{-0.5f, 0, 0.55f}, {-0.5f, 0.8f, 0.55f}, {-0.5f, -0.8f, 0.55f}},
+           Vector3f(-0.5f, 0, 0.03f), 2, 90000);
+    const Tally t = tally(m, 2.3f, 4.3f, -0.6f, 0.6f, ramp_z);  // above the sensor's 0.55 m
+    EXPECT_GE(t.trav, t.samples / 2) << t.str();
+    trav[on] = t.trav;
+  }
+  EXPECT_GE(trav[1], trav[0] * 95 / 100);
+}
+
+// A patch whose points first came with rays rising 0.04 (from below: an edge's top grazed from the
+// flight under it), then with level rays from fewer scans (N(v) does not double): it is judged
+// again at once and reads as a floor (the top of the teaching building's flight, seen from its
+// last treads, stayed S_untrav and the upper floor was left).
+TEST(Terrain, ASurfaceSeenFromBelowThenFromItsOwnLevelIsAFloorAtOnce) {
+  MapOptions opt;
+  opt.floor_seen_from_above = true;
+  TraversabilityMap m(opt);
+  std::vector<Vector3f> patch;
+  for (float x = 4.51f; x < 5.5f; x += 0.02f)
+    for (float y = -0.49f; y < 0.5f; y += 0.02f) patch.emplace_back(x, y, 0.75f);
+  for (int rep = 0; rep < 3; ++rep) m.insert_scan(Vector3f(0, 0, 0.55f), patch);
+  m.update_traversability();
+  const auto top = [](float, float) { return 0.75f; };
+  const Tally below = tally(m, 4.6f, 5.4f, -0.4f, 0.4f, top);
+  EXPECT_EQ(below.trav, 0) << below.str();
+  EXPECT_EQ(below.found, below.samples) << below.str();
+  m.insert_scan(Vector3f(0, 0, 0.75f), patch);
+  m.update_traversability();
+  const Tally level = tally(m, 4.6f, 5.4f, -0.4f, 0.4f, top);
+  EXPECT_EQ(level.trav, level.samples) << level.str();
 }
