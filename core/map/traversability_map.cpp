@@ -136,7 +136,7 @@ InsertStats TraversabilityMap::insert_scan(const Eigen::Vector3f& o,
     VoxelStats& vs = b->stats[c.stats];
     vs.add(float(p.x() - (k.x + 0.5) * s), float(p.y() - (k.y + 0.5) * s),
            float(p.z() - (k.z + 0.5) * s));
-    {
+    if (opt_.floor_seen_from_above) {  // per point: only when used
       const float run = std::max(std::hypot(p.x() - o.x(), p.y() - o.y()), 1e-3f);
       const int rise =
           int(std::lround(std::clamp(100.0f * (p.z() - o.z()) / run, -127.0f, 127.0f)));
@@ -145,8 +145,7 @@ InsertStats TraversabilityMap::insert_scan(const Eigen::Vector3f& o,
       // on doubling N(v), a floor grazed from the flight below and then from the top of the
       // flight stayed S_untrav: the teaching building's upper floor was left.)
       if (rise < vs.min_rise) {
-        if (opt_.floor_seen_from_above && vs.min_rise >= 2 && (rise < 2 || rise <= vs.min_rise - 5))
-          mark_changed(k, c);
+        if (vs.min_rise >= 2 && (rise < 2 || rise <= vs.min_rise - 5)) mark_changed(k, c);
         vs.min_rise = int8_t(rise);
       }
     }
