@@ -1046,26 +1046,26 @@ bool LocalPlanner::try_target(const LocalPlanInput& in, const Viewpoint& vp, Loc
   if (path.status != VoxelAStarStatus::kOk) on_graph = graph_path();
   if (path.status != VoxelAStarStatus::kOk || path.points_m.empty()) return false;
   *why = SetAsideReason::kTrajectoryFailed;
-  // A flight's foot: onto its axis from where the search stopped (within astar_goal_tolerance_m;
-  // house seed 5 with a 0.3 rad yaw gate stood 0.21 m beside the axis, the climb from there failed
-  // and the flight was never tried again), no nearer the first riser than the search came (the
-  // body's front over the riser pitches it). Without that step if the body meets something.
-  const Eigen::Vector2d axis(std::cos(vp.yaw_rad), std::sin(vp.yaw_rad));
-  const Eigen::Vector2d off = (path.points_m.back() - vp.p_m).head<2>();
-  const double beside = std::abs(off.x() * axis.y() - off.y() * axis.x());
-  const bool to_foot = goal == Goal::kFlightFoot && beside > 0.05;
-  std::vector<Eigen::Vector3d> short_of_foot;
-  if (to_foot) {
-    short_of_foot = path.points_m;
-    short_of_foot.front() = start_foot_m_;
-    Eigen::Vector3d on_axis = vp.p_m;
-    on_axis.head<2>() += std::min(0.0, off.dot(axis)) * axis;
-    path.points_m.push_back(on_axis);
-  }
   // The path starts at the robot's support voxel; start the curve at the robot itself (or at
   // the nearest collision-free pose, see free_start()). The B-spline is checked against the
   // body with FCL whichever path it follows.
   path.points_m.front() = start_foot_m_;
+  // A flight's foot: onto its axis from where the search stopped (within astar_goal_tolerance_m;
+  // house seed 5 with a 0.3 rad yaw gate stood 0.21 m beside the axis, the climb from there failed
+  // and the flight was never tried again), no nearer the first riser than the search came (the
+  // body's front over the riser pitches it). Without that step if the body meets something.
+  std::vector<Eigen::Vector3d> short_of_foot;
+  if (goal == Goal::kFlightFoot) {
+    const Eigen::Vector2d axis(std::cos(vp.yaw_rad), std::sin(vp.yaw_rad));
+    const Eigen::Vector2d off = (path.points_m.back() - vp.p_m).head<2>();
+    if (std::abs(off.x() * axis.y() - off.y() * axis.x()) > 0.05) {
+      short_of_foot = path.points_m;
+      Eigen::Vector3d on_axis = vp.p_m;
+      on_axis.head<2>() += std::min(0.0, off.dot(axis)) * axis;
+      path.points_m.push_back(on_axis);
+    }
+  }
+  const bool to_foot = !short_of_foot.empty();
   // The goal yaw: the viewpoint's (facing the cluster), none with PlanOptions::face_cluster off
   // for a cluster's viewpoint (the curve's own end yaw), a flight's axis if the path ends on one.
   const bool free_yaw = goal == Goal::kClusterView && !plan_opt_.face_cluster;
