@@ -194,6 +194,7 @@ void read_plan(SectionReader&& r, core::plan::PlanOptions& o) {
   r.get("reference_clock", o.reference_clock);
   r.get("reference_catch_up", o.reference_catch_up);
   r.get("start_at_speed", o.start_at_speed);
+  r.get("turn_before_walk", o.turn_before_walk);
   r.get("no_progress_s", o.no_progress_s, Range{0.0, 600.0});
   r.get("stale_floor_s", o.stale_floor_s, Range{0.0, 3600.0});
   r.get("replan_only_if_faster", o.replan_only_if_faster);
@@ -251,6 +252,7 @@ void read_safety(SectionReader&& r, SafetyConfig& o) {
   r.get("turn_on_reference", o.turn_on_reference);
   r.get("lookahead_on_plan_grid", o.lookahead_on_plan_grid);
   r.get("reference_yaw_gate_rad", o.reference_yaw_gate_rad, Range{0.05, 3.0});
+  r.get("reference_speed_lead_mps", o.reference_speed_lead_mps, Range{0.0, 5.0});
 }
 
 void read_link(SectionReader&& r, LinkConfig& o) {

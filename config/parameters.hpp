@@ -87,6 +87,11 @@ struct SafetyConfig {
   // The reference slows for a yaw error above this and waits from twice it
   // (ControlLaw::progress_rate) [rad].
   double reference_yaw_gate_rad = 0.6;
+  // The reference moves at most this much faster than the robot along it
+  // (ControlLaw::speed_rate): a trajectory entered mid-way at walking speed by a robot braked
+  // nearly to rest ran 0.3 m ahead round a bend, and the body cut it into a wall (house seed 1,
+  // session 32). 0: off [m/s].
+  double reference_speed_lead_mps = 0.0;
 };
 
 enum class LinkTransport { kDds, kUdp, kCan, kSim };

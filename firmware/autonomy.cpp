@@ -499,11 +499,14 @@ void Autonomy::control_step() {
     tau_ = s;
   }
   core::plan::TrajectorySample ref;
-  double err = 0;
+  double err = 0, speed_k = 1.0;
   if (has_traj) {
     ref = ctl_traj_->trajectory.sample(std::min(tau_, tau_end));
     if (tau_ >= tau_end) ref.v_mps.setZero(), ref.yaw_rate_rps = 0;  // hold the end pose
     ref.v_mps *= brake_k_, ref.yaw_rate_rps *= brake_k_;             // braking on it: slower
+    speed_k = ControlLaw::speed_rate(ref.v_mps.head<2>(), last_pose_.velocity_world(),
+                                     opt_.params.safety.reference_speed_lead_mps);
+    ref.v_mps *= speed_k, ref.yaw_rate_rps *= speed_k;  // no faster than the robot can follow
     err = (ref.p_m - last_pose_.position()).head<2>().norm();
   }
   const bool following = has_traj && (tau_ < tau_end || err > 0.15);
@@ -569,8 +572,8 @@ void Autonomy::control_step() {
     // waits for the robot instead of running away from it.
     const double rate = ControlLaw::progress_rate(err, wrap_angle(ref.yaw_rad - last_pose_.yaw_rad),
                                                   opt_.params.safety.reference_yaw_gate_rad);
-    if (tau_ < tau_end) lag_s_ += dt * (1.0 - rate * brake_k_);
-    tau_ = std::min(tau_ + dt * rate * brake_k_, tau_end);
+    if (tau_ < tau_end) lag_s_ += dt * (1.0 - rate * brake_k_ * speed_k);
+    tau_ = std::min(tau_ + dt * rate * brake_k_ * speed_k, tau_end);
   } else if (has_traj && tau_ < tau_end) {
     lag_s_ += dt;  // stopped: the reference waits
   }

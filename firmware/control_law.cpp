@@ -133,4 +133,13 @@ double ControlLaw::progress_rate(double position_err_m, double yaw_err_rad, doub
          std::clamp((2.0 * g - std::abs(yaw_err_rad)) / g, 0.0, 1.0);
 }
 
+double ControlLaw::speed_rate(const Eigen::Vector2d& ref_v, const Eigen::Vector2d& robot_v,
+                              double lead_mps) {
+  const double s = ref_v.norm();
+  if (!(lead_mps > 0) || !(s > 1e-6)) return 1.0;
+  const double along = std::max(0.0, robot_v.dot(ref_v) / s);
+  const double r = (along + lead_mps) / s;
+  return std::isfinite(r) ? std::min(1.0, r) : 1.0;
+}
+
 }  // namespace storey::firmware

@@ -61,6 +61,13 @@ class ControlLaw {
   // instead of running away from it. The body turned behind its reference sweeps poses FCL
   // never checked (safety.reference_yaw_gate_rad).
   static double progress_rate(double position_err_m, double yaw_err_rad, double yaw_gate_rad);
+  // safety.reference_speed_lead_mps: the rate [0, 1] at which a reference moving at ref_v (world,
+  // planar) may advance for a robot moving at robot_v: its speed is held to the robot's speed
+  // along it plus lead_mps. Entered mid-way (ControlLaw::entry_time) or after a stop, a reference
+  // at walking speed leaves a robot near rest behind: it needs v / a_max to catch up and cuts the
+  // corners the reference goes round. 1 with lead_mps <= 0 (off).
+  static double speed_rate(const Eigen::Vector2d& ref_v, const Eigen::Vector2d& robot_v,
+                           double lead_mps);
   // Clamps a command to speed / yaw-rate limits and rate-limits it against prev (exposed for
   // tests).
   VelocityCommand limit(VelocityCommand cmd, const VelocityCommand& prev, double dt_s) const;

@@ -17,19 +17,29 @@ bool can_turn_at(CollisionChecker& checker, const map::MapView& view, const Eige
 std::optional<StraightWalk> straight_walk(CollisionChecker& checker, const map::MapView& view,
                                           const RobotModel& robot,
                                           const std::vector<Eigen::Vector3d>& pts, double yaw,
-                                          double t0) {
+                                          double t0, double from_yaw) {
   if (pts.size() < 2) return std::nullopt;
-  std::vector<Eigen::Vector3d> c(2, pts.front());
-  c.insert(c.end(), pts.begin(), pts.end());
-  c.insert(c.end(), 2, pts.back());
   double len = 0;
   for (size_t j = 1; j < pts.size(); ++j) len += (pts[j] - pts[j - 1]).head<2>().norm();
   const double seg = len / double(pts.size() - 1);
   // Knot interval: half speed, and the acceleration limit at the tripled ends.
-  const double dt = std::max(seg / (0.5 * robot.max_speed_mps),
-                             std::sqrt(seg / std::max(robot.max_accel_mps2, 1e-3)));
-  const std::vector<double> yaws(c.size(), yaw);
-  BsplineTrajectory t(std::move(c), yaws, std::max(dt, 1e-3), t0);
+  const double dt = std::max({seg / (0.5 * robot.max_speed_mps),
+                              std::sqrt(seg / std::max(robot.max_accel_mps2, 1e-3)), 1e-3});
+  const double turn = std::isfinite(from_yaw) ? std::remainder(yaw - from_yaw, 2.0 * M_PI) : 0.0;
+  // Yaw per knot on the spot: half the yaw-rate limit, and half the yaw-acceleration limit over
+  // one knot interval (the B-spline's yaw rate ramps up across it).
+  const double per_knot = std::max(
+      0.5 * std::min(robot.max_yaw_rate_rps * dt, robot.max_yaw_accel_rps2 * dt * dt), 1e-3);
+  // The shorter way round only: the body box is centred on its foot and symmetric, so the longer
+  // way sweeps every orientation the shorter one does.
+  const int m = std::abs(turn) > 0.1 ? int(std::ceil(std::abs(turn) / per_knot)) : 0;
+  std::vector<Eigen::Vector3d> c(3 + size_t(m), pts.front());  // tripled: starts exactly there
+  std::vector<double> yaws(3, m > 0 ? from_yaw : yaw);
+  for (int j = 1; j <= m; ++j) yaws.push_back(from_yaw + turn * double(j) / m);
+  c.insert(c.end(), pts.begin() + 1, pts.end());
+  c.insert(c.end(), 2, pts.back());
+  yaws.resize(c.size(), m > 0 ? from_yaw + turn : yaw);
+  BsplineTrajectory t(std::move(c), std::move(yaws), dt, t0);
   const CollisionHit hit = checker.check_ahead(
       view, [&](double tt) { return t.pose(tt); }, t.t_start(), t.duration(), 0.0);
   if (hit.collides) return std::nullopt;

@@ -698,7 +698,8 @@ void LocalPlanner::adopt_foot(const LocalPlanInput& in, const FlightFoot& f, con
 
 bool LocalPlanner::straight_walk(const LocalPlanInput& in, const std::vector<Eigen::Vector3d>& pts,
                                  double yaw, LocalPlanResult& out) {
-  auto w = plan::straight_walk(checker_, *in.view, robot_, pts, yaw, in.t_s);
+  auto w = plan::straight_walk(checker_, *in.view, robot_, pts, yaw, in.t_s,
+                               plan_opt_.turn_before_walk ? in.robot_yaw_rad : NAN);
   if (!w) return false;
   take_walk(std::move(*w), yaw, out);
   return true;

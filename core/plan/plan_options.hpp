@@ -143,6 +143,10 @@ struct PlanOptions {
   // it starts at rest as before (brake_start). Started at rest, every replan left the robot
   // ahead of its reference (0.47 m in office seed 2's table-leg collision, session 28).
   bool start_at_speed = false;
+  // Beyond the paper (session 32): a straight walk (a climb, a descent) from a robot facing
+  // elsewhere first turns the body on the spot, and that turn is collision-checked
+  // (straight_walk's from_yaw); else the body turned there unchecked.
+  bool turn_before_walk = false;
   bool incremental_maintenance = true;
 };
 

@@ -50,6 +50,51 @@ TEST(Escape, OutOfACorridorTooNarrowToTurnInIntoTheRoom) {
   EXPECT_TRUE(escape_to_turn(checker, view, robot, {1.5, 0, 0}, 0.0, 0.0, 0.5).has_value());
 }
 
+// PlanOptions::turn_before_walk: a straight walk for a robot facing elsewhere first turns the body
+// on the spot, the shorter way, within the yaw limits, and that turn is checked: in the corridor
+// the body cannot turn, so a walk that starts with a turn there is refused, and in the room the
+// same walk turns first and then keeps the walk's yaw.
+TEST(Escape, AStraightWalkTurnsTheBodyOnTheSpotFirstAndChecksTheTurn) {
+  const map::TraversabilityMap m = corridor_into_room();
+  const map::MapView view = m.view();
+  const RobotModel robot;
+  CollisionChecker checker(robot, view.voxel_size_m());
+  const auto line = [](Eigen::Vector3d a, Eigen::Vector3d b) {
+    std::vector<Eigen::Vector3d> pts;
+    for (int j = 0; j <= 10; ++j) pts.push_back(a + (b - a) * (j / 10.0));
+    return pts;
+  };
+  // Along the corridor, facing along it: no turn needed, and the walk passes.
+  const auto along = line({-1.5, 0, 0}, {-0.5, 0, 0});
+  EXPECT_TRUE(straight_walk(checker, view, robot, along, 0.0, 0.0, 0.05).has_value());
+  // Facing across the corridor (yaw kept, as without the turn, the body at -pi/2 is not checked
+  // along the way it turns): with the turn it is refused.
+  EXPECT_TRUE(straight_walk(checker, view, robot, along, 0.0, 0.0).has_value());
+  EXPECT_FALSE(straight_walk(checker, view, robot, along, 0.0, 0.0, 1.2).has_value());
+  // In the room, from facing -y (yaw -pi/2) to walk +x: a quarter turn left on the spot first.
+  const auto room = line({1.5, 0, 0}, {2.5, 0, 0});
+  const auto w = straight_walk(checker, view, robot, room, 0.0, 10.0, -M_PI / 2);
+  ASSERT_TRUE(w.has_value());
+  const BsplineTrajectory& t = w->trajectory;
+  EXPECT_NEAR(t.pose(t.t_start()).yaw_rad, -M_PI / 2, 1e-9);
+  EXPECT_NEAR(t.pose(t.t_end()).yaw_rad, 0.0, 1e-9);
+  double max_rate = 0, yaw_when_moving = -M_PI;
+  for (double s = t.t_start(); s <= t.t_end(); s += 0.01) {
+    const TrajectorySample q = t.sample(s);
+    max_rate = std::max(max_rate, std::abs(q.yaw_rate_rps));
+    EXPECT_GE(q.yaw_rad, -M_PI / 2 - 1e-9);  // the shorter way: never beyond the start
+    EXPECT_LE(q.yaw_rad, 1e-9);
+    if ((q.p_m - room.front()).head<2>().norm() > 0.1 && yaw_when_moving == -M_PI)
+      yaw_when_moving = q.yaw_rad;
+  }
+  EXPECT_LE(max_rate, 0.5 * robot.max_yaw_rate_rps + 1e-6);
+  EXPECT_GT(yaw_when_moving, -0.1);  // turned before it walked a decimetre
+  // From +3 rad the shorter way to 0 is down through +pi/2, not up past pi.
+  const auto back = straight_walk(checker, view, robot, room, 0.0, 10.0, 3.0);
+  ASSERT_TRUE(back.has_value());
+  EXPECT_NEAR(back->trajectory.pose(back->trajectory.t_end()).yaw_rad, 0.0, 1e-9);
+}
+
 TEST(Escape, NearestFreeFootStepsAwayFromAWallItOverlaps) {
   const map::TraversabilityMap m = corridor_into_room();
   const map::MapView view = m.view();

@@ -217,6 +217,85 @@ TEST(ControlLaw, TheReferenceWaitsForABodyBehindItInPositionOrYaw) {
   EXPECT_NEAR(ControlLaw::progress_rate(0.45, 0.45, 0.3), 0.25, 1e-12);
 }
 
+// safety.reference_speed_lead_mps: a robot near rest that enters a trajectory mid-way, where its
+// reference walks at 0.7 m/s into a bend, trails the reference and cuts the bend (house seed 1,
+// session 32: 0.31 m behind it, the body met a wall). Held to the robot's speed plus the lead,
+// the reference waits for it, and the body stays on the curve the planner checked.
+TEST(ControlLaw, TheReferenceIsNoFasterThanTheRobotCanFollow) {
+  EXPECT_DOUBLE_EQ(ControlLaw::speed_rate({0.7, 0}, {0, 0}, 0.0), 1.0);  // off
+  EXPECT_NEAR(ControlLaw::speed_rate({0.7, 0}, {0, 0}, 0.35), 0.5, 1e-12);
+  EXPECT_NEAR(ControlLaw::speed_rate({0.7, 0}, {0.2, 0}, 0.3), 5.0 / 7.0, 1e-12);
+  EXPECT_NEAR(ControlLaw::speed_rate({0.7, 0}, {0.2, 0}, 0.1), 3.0 / 7.0, 1e-12);
+  EXPECT_NEAR(ControlLaw::speed_rate({0.7, 0}, {0, 0.5}, 0.35), 0.5, 1e-12);  // sideways: none
+  EXPECT_NEAR(ControlLaw::speed_rate({0.7, 0}, {-0.5, 0}, 0.35), 0.5, 1e-12);
+  EXPECT_DOUBLE_EQ(ControlLaw::speed_rate({0.7, 0}, {0.5, 0}, 0.3), 1.0);
+  EXPECT_DOUBLE_EQ(ControlLaw::speed_rate({0, 0}, {0, 0}, 0.3), 1.0);  // at rest
+
+  core::RobotModel robot;
+  ControlLaw law(robot);
+  // 0.5 m per knot at 0.7 s: 0.7 m/s along +x, then a right-angle bend to +y at x = 1.5.
+  std::vector<Eigen::Vector3d> ctrl;
+  std::vector<double> yaws;
+  for (const auto& [x, y] : std::vector<std::pair<double, double>>{{0, 0},
+                                                                   {0, 0},
+                                                                   {0, 0},
+                                                                   {0.5, 0},
+                                                                   {1, 0},
+                                                                   {1.5, 0},
+                                                                   {1.5, 0.5},
+                                                                   {1.5, 1},
+                                                                   {1.5, 1.5},
+                                                                   {1.5, 1.5},
+                                                                   {1.5, 1.5}}) {
+    ctrl.emplace_back(x, y, 0.0);
+    yaws.push_back(y > 0 ? M_PI / 2 : 0.0);
+  }
+  const core::plan::BsplineTrajectory t(ctrl, yaws, 0.7, 0.0);
+  std::vector<Eigen::Vector2d> curve;
+  for (double s = t.t_start(); s <= t.t_end(); s += 0.005)
+    curve.push_back(t.sample(s).p_m.head<2>());
+  const auto off_curve = [&](const PoseSample& p) {
+    double d = 1e9;
+    for (const auto& c : curve) d = std::min(d, (c - Eigen::Vector2d(p.x_m, p.y_m)).norm());
+    return d;
+  };
+  const auto follow = [&](double lead_mps, double enter_x, double v0) {
+    PoseSample pose;
+    double tau = ControlLaw::entry_time(t, {enter_x, 0.0});
+    pose.x_m = t.sample(tau).p_m.x();
+    pose.vx_mps = v0;
+    VelocityCommand prev;
+    prev.vx_mps = v0;
+    double worst = 0;
+    const double dt = 0.02;
+    for (int i = 0; i < 500; ++i) {
+      core::plan::TrajectorySample ref = t.sample(std::min(tau, t.t_end()));
+      const double k = ControlLaw::speed_rate(ref.v_mps.head<2>(), pose.velocity_world(), lead_mps);
+      ref.v_mps *= k, ref.yaw_rate_rps *= k;
+      const VelocityCommand c = law.track(ref, pose, prev, dt);
+      pose.x_m += dt * (std::cos(pose.yaw_rad) * c.vx_mps - std::sin(pose.yaw_rad) * c.vy_mps);
+      pose.y_m += dt * (std::sin(pose.yaw_rad) * c.vx_mps + std::cos(pose.yaw_rad) * c.vy_mps);
+      pose.yaw_rad += dt * c.yaw_rate_rps;
+      pose.vx_mps = c.vx_mps, pose.vy_mps = c.vy_mps, pose.yaw_rate_rps = c.yaw_rate_rps;
+      const double err = std::hypot(ref.p_m.x() - pose.x_m, ref.p_m.y() - pose.y_m);
+      tau += dt * k * ControlLaw::progress_rate(err, wrap_angle(ref.yaw_rad - pose.yaw_rad), 0.6);
+      worst = std::max(worst, off_curve(pose));
+      prev = c;
+    }
+    EXPECT_LT(std::hypot(pose.x_m - 1.5, pose.y_m - 1.5), 0.05) << "lead " << lead_mps;
+    return worst;
+  };
+  // Entered where it starts, at rest: what tracking the curve costs anyway.
+  const double from_start = follow(0.0, 0.0, 0.0);
+  // Entered mid-way, braked nearly to rest.
+  const double free_running = follow(0.0, 1.1, 0.1), held = follow(0.1, 1.1, 0.1);
+  std::printf("body off the curve: %.3f m from the start, %.3f m free running, %.3f m held\n",
+              from_start, free_running, held);
+  EXPECT_LT(from_start, 0.01);
+  EXPECT_GT(free_running, 0.06);
+  EXPECT_LT(held, 0.03);
+}
+
 TEST(ControlLaw, FeedforwardInBodyFrameAndNanGuard) {
   core::RobotModel robot;
   ControlLaw law(robot);

@@ -98,6 +98,7 @@ struct RecordInputs {
   const GroundTruth* gt;
   const Autonomy* autonomy;
   const std::vector<Eigen::Vector3d>* path;
+  const std::string* tracking_csv;  // tracking.csv's rows (10 Hz)
   const SimRunResult* result;
   std::string error;  // set when the run failed with an exception
 };
@@ -177,6 +178,13 @@ void write_record(const RecordInputs& in, std::vector<std::string>& written) {
          "virtual)\n\n```\n"
       << latency << "```\n";
     written.push_back("latency.md");
+  }
+  {
+    std::ofstream f(dir + "/tracking.csv");
+    f << "t_s,x_m,y_m,z_m,yaw_deg,trajectory,tau_s,lag_s,ref_x_m,ref_y_m,ref_yaw_deg,ahead_m,"
+         "left_m\n"
+      << *in.tracking_csv;
+    if (f) written.push_back("tracking.csv");
   }
   // Pictures: one top-down view per ground-truth floor, one side view.
   std::vector<std::string> pictures;
@@ -375,6 +383,7 @@ SimRunResult run_exploration(const SimRunOptions& opt) {
   std::int64_t t_ns = 0, next_progress = progress_ns, next_path = 0;
   uint32_t collisions_seen = 0, falls_seen = 0;
   std::vector<float> side_m;  // |body to reference, sideways| every slice (RunMetrics::tracking)
+  std::string tracking_csv;   // the body and its reference at 10 Hz (tracking.csv)
   double ahead_max_m = 0;
   std::string error;
   try {
@@ -397,9 +406,25 @@ SimRunResult run_exploration(const SimRunOptions& opt) {
         collisions_seen = rs.collisions;
         falls_seen = rs.falls;
       }
-      if (const auto o = reference_offset(autonomy, world.robot_state())) {
+      const auto o = reference_offset(autonomy, world.robot_state());
+      if (o) {
         side_m.push_back(float(std::abs(o->left_m)));
         ahead_max_m = std::max(ahead_max_m, o->ahead_m);
+      }
+      if (t_ns % 100'000'000 == 0 && !opt.out_dir.empty()) {
+        const RobotState& rs = world.robot_state();
+        const firmware::TrajectoryProgress pr = autonomy.trajectory_progress();
+        char row[256];
+        int n = std::snprintf(row, sizeof row, "%.2f,%.3f,%.3f,%.3f,%.1f,%llu,%.2f,%.2f", t,
+                              rs.position.x(), rs.position.y(), rs.position.z(),
+                              rs.yaw * 180 / M_PI, (unsigned long long)pr.id, pr.tau_s, pr.lag_s);
+        if (o)
+          std::snprintf(row + n, sizeof row - size_t(n), ",%.3f,%.3f,%.1f,%.3f,%.3f\n",
+                        o->ref.foot_m.x(), o->ref.foot_m.y(), o->ref.yaw_rad * 180 / M_PI,
+                        o->ahead_m, o->left_m);
+        else
+          std::snprintf(row + n, sizeof row - size_t(n), ",,,,,\n");
+        tracking_csv += row;
       }
       if (t_ns >= next_path) {
         path.push_back(world.robot_state().position);
@@ -490,7 +515,7 @@ SimRunResult run_exploration(const SimRunOptions& opt) {
               m.collisions == 0 && m.falls == 0;
 
   if (!opt.out_dir.empty()) {
-    RecordInputs ri{&opt, &scene, &gt, &autonomy, &path, &res, error};
+    RecordInputs ri{&opt, &scene, &gt, &autonomy, &path, &tracking_csv, &res, error};
     std::vector<std::string> written;
     write_record(ri, written);
     res.report_path = opt.out_dir + "/report.md";
