@@ -512,10 +512,22 @@ void LocalPlanner::brake_start(const LocalPlanInput& in) {
           next += 0.05;
         }
       }
-      if (way.empty() || checker_.check_poses(*in.view, way).collides) return;
-      start_foot_m_ = way.back().foot_m;
-      start_yaw_ = way.back().yaw_rad;
-      return;
+      // Only a trajectory the robot moves along: the one last published may be one the control
+      // task has not entered yet (it brakes on the one before, plan.brake_start), starting where
+      // that braking ends and heading back; a rest point predicted along it lay behind the robot
+      // (house seed 5, session 32: a new start 0.17 m beside where the body came to rest).
+      const Eigen::Vector2d to_rest =
+          way.empty() ? Eigen::Vector2d::Zero()
+                      : Eigen::Vector2d((way.back().foot_m - in.robot_foot_m).head<2>());
+      const bool along =
+          !plan_opt_.brake_along_motion || to_rest.dot(v) > 0.5 * to_rest.norm() * v.norm();
+      if (along) {
+        if (way.empty() || checker_.check_poses(*in.view, way).collides) return;
+        start_foot_m_ = way.back().foot_m;
+        start_yaw_ = way.back().yaw_rad;
+        return;
+      }
+      way.clear();
     }
   }
   const Eigen::Vector2d u = v.normalized();

@@ -147,6 +147,10 @@ struct PlanOptions {
   // elsewhere first turns the body on the spot, and that turn is collision-checked
   // (straight_walk's from_yaw); else the body turned there unchecked.
   bool turn_before_walk = false;
+  // brake_start predicts the rest point along the last published trajectory only where that
+  // point lies within 60 deg of the robot's velocity, else straight along the velocity
+  // (session 32).
+  bool brake_along_motion = false;
   bool incremental_maintenance = true;
 };
 

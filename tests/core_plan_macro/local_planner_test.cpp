@@ -974,6 +974,38 @@ TEST(LocalPlanner, AMovingRobotsTrajectoryStartsWhereItComesToRest) {
   EXPECT_NEAR(still.head<2>().norm(), 0.0, 0.03) << still.transpose();
 }
 
+// PlanOptions::brake_along_motion: the last published trajectory is one the control task may not
+// have entered yet (it brakes on the one before, plan.brake_start). A robot moving against it
+// comes to rest straight along its velocity, not along that trajectory behind it (house seed 5,
+// session 32: a new start 0.17 m beside where the body came to rest, entered with a 125 deg
+// turn).
+TEST(LocalPlanner, ARobotMovingAgainstTheLastTrajectoryComesToRestAlongItsVelocity) {
+  auto replanned_start = [](bool along_motion) {
+    Harness h;
+    const World w = corridor();
+    EXPECT_TRUE(scan_from(h, w, Eigen::Vector3f::Zero()));
+    PlanOptions po;
+    po.brake_start = true;
+    po.brake_along_motion = along_motion;
+    LocalPlanner lp(RobotModel{}, po, 0.1);
+    const auto view = h.map.view();
+    LocalPlanInput in = input(h, view, {-2, 0, 0}, 0.0);
+    const LocalPlanResult first = lp.plan(in);  // at rest, toward +x
+    EXPECT_EQ(first.status, LocalPlanStatus::kNewTrajectory) << first.replan_reason;
+    const TrajectorySample s0 = first.trajectory.sample(first.trajectory.t_start() + 1.0);
+    EXPECT_GT(s0.v_mps.x(), 0.1);
+    LocalPlanInput again = input(h, view, {-1.9f, 0, 0}, 0.5);
+    again.robot_velocity_mps = {-0.8, 0.0};  // still moving the other way, on the one before
+    lp.drop_target();  // a new target: a new trajectory from where braking ends
+    const LocalPlanResult r = lp.plan(again);
+    EXPECT_EQ(r.status, LocalPlanStatus::kNewTrajectory) << r.replan_reason;
+    return r.trajectory.sample(r.trajectory.t_start()).p_m;
+  };
+  const Eigen::Vector3d along = replanned_start(true), old = replanned_start(false);
+  EXPECT_NEAR(along.x(), -1.9 - 0.32, 0.03) << along.transpose();  // 0.8^2 / 2 behind it
+  EXPECT_GT(old.x(), -1.9) << old.transpose();  // ahead along the trajectory: behind the motion
+}
+
 // PlanOptions::start_at_speed: the moving robot's new trajectory leaves its foot along its
 // velocity at its speed (not at rest where braking would end); a robot slower than
 // kAtSpeedMinMps, or heading into the wall 0.8 m away (the curve cannot keep 0.8 of the speed
