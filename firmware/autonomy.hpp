@@ -67,7 +67,10 @@ struct TrajectoryProgress {
   double tau_s = 0;  // the reference's time now, on the trajectory's clock [s]
 };
 
-enum class ExplorationState : uint8_t { kStarting = 0, kExploring, kComplete };
+// kStranded: nothing left the robot can reach, but frontiers unreachable from a robot cut off in
+// a small part of its graph (Autonomy::kStrandedShare): the run ends, and says so, instead of
+// claiming the building explored.
+enum class ExplorationState : uint8_t { kStarting = 0, kExploring, kComplete, kStranded };
 
 // Plain status (Mailbox): for progress lines, the run record, and ending the run.
 struct ExplorationStatus {
@@ -82,6 +85,7 @@ struct ExplorationStatus {
   // no node connected to the robot through G_real (computed by the plan task when the policy has
   // nothing to do).
   uint32_t clusters_set_aside = 0, clusters_unreachable = 0;
+  uint32_t robot_component_nodes = 0;  // nodes connected to the robot's through G_real
   // A baseline's own set-aside goals (GoalDriver::SetAsideCounts; all -1 for the storey method).
   int32_t goals_stood_at = -1, goals_overdue = -1, goals_no_trajectory = -1;
   uint64_t trajectories = 0, plan_cycles = 0;
@@ -101,7 +105,7 @@ const char* to_string(ExplorationState s);
 
 // Plan task -> telemetry (non-RT log): floor changes, prior built, failures, completion.
 struct PlanEvent {
-  enum Kind : uint8_t { kFloor = 0, kPrior, kFailed, kComplete } kind = kFloor;
+  enum Kind : uint8_t { kFloor = 0, kPrior, kFailed, kComplete, kStranded } kind = kFloor;
   double t_s = 0;
   int32_t floor = -1, reference_floor = -1;
   double dz_m = 0;
@@ -141,6 +145,15 @@ struct AutonomyOptions {
 
 class Autonomy {
  public:
+  // Stranded: frontier clusters unreachable and the robot's node in a component holding fewer
+  // than this share of the graph's nodes. A floor climbed blind is a component of its own (house:
+  // half the graph), so the share is small.
+  static constexpr double kStrandedShare = 0.1;
+  // Whether an exhausted status (no target left) is stranded rather than complete.
+  static bool stranded(const ExplorationStatus& s) {
+    return s.clusters_unreachable > 0 &&
+           double(s.robot_component_nodes) < kStrandedShare * double(s.nodes);
+  }
   Autonomy(Platform& platform, const rt::Clock& clock, AutonomyOptions options);
   ~Autonomy();
   Autonomy(const Autonomy&) = delete;
@@ -248,6 +261,7 @@ class Autonomy {
   uint64_t traj_id_ = 0, plan_cycles_ = 0, trajectories_ = 0;
   double idle_since_s_ = -1;
   bool complete_ = false;
+  bool stranded_ = false;  // complete_ with the robot cut off (ExplorationState::kStranded)
 
   // control task
   ControlLaw law_;
@@ -263,6 +277,10 @@ class Autonomy {
   // old one's progress and feedforward scaled by brake_k_, falling 1 -> 0 at a_max from brake_v0_.
   std::shared_ptr<const PlannedTrajectory> pending_;
   double brake_k_ = 1.0, brake_v0_ = 0;
+  // plan.enter_at_rest: entered at rest further than kEnterGapM from it, a trajectory is held
+  // (zero command) until the replan asked for arrives, or hold_until_s_; once per place.
+  double hold_until_s_ = -1;
+  Eigen::Vector2d held_at_ = Eigen::Vector2d::Constant(NAN);
   bool collision_predicted_ = false;
   VelocityCommand prev_cmd_;
   PoseSample last_pose_;

@@ -279,6 +279,15 @@ int cmd_run(int argc, char** argv) {
       summary.end_reason = "exploration complete";
       break;
     }
+    if (st.state == ExplorationState::kStranded) {
+      char why[160];
+      std::snprintf(why, sizeof why,
+                    "stranded: %u frontier clusters unreachable from the robot, cut off in %u of "
+                    "%u graph nodes",
+                    st.clusters_unreachable, st.robot_component_nodes, st.nodes);
+      summary.end_reason = why;
+      break;
+    }
     if (duration_s > 0 && t >= duration_s) {
       char why[64];
       std::snprintf(why, sizeof why, "duration reached (%.0f s)", duration_s);

@@ -431,7 +431,8 @@ SimRunResult run_exploration(const SimRunOptions& opt) {
         next_path += 200'000'000;  // 5 Hz
       }
       const firmware::ExplorationStatus st = autonomy.status();
-      const bool done = st.state == firmware::ExplorationState::kComplete;
+      const bool stranded = st.state == firmware::ExplorationState::kStranded;
+      const bool done = st.state == firmware::ExplorationState::kComplete || stranded;
       if (progress_ns > 0 && (t_ns >= next_progress || done)) {
         next_progress += progress_ns;
         const Coverage c = sample_coverage(t);
@@ -446,9 +447,15 @@ SimRunResult run_exploration(const SimRunOptions& opt) {
         progress(line);
       }
       if (done) {
-        res.completed = true;
+        res.completed = !stranded;
         char why[320];
-        if (st.goals_stood_at >= 0)  // a baseline: its own goals, not the storey clusters
+        if (stranded)
+          std::snprintf(why, sizeof why,
+                        "stranded at %.1f s: %s, but %u of %u clusters are unreachable from the "
+                        "robot's node, in a part of the graph of %u of %u nodes",
+                        t, st.plan_reason, st.clusters_unreachable, st.clusters,
+                        st.robot_component_nodes, st.nodes);
+        else if (st.goals_stood_at >= 0)  // a baseline: its own goals, not the storey clusters
           std::snprintf(why, sizeof why,
                         "exploration complete at %.1f s: %s (%s: goals set aside: %d stood at, "
                         "%d overdue, %d without a trajectory)",

@@ -1,0 +1,34 @@
+// How an exhausted run ends (firmware/autonomy.hpp): complete, or stranded when the frontiers
+// left are unreachable from a robot cut off in a small part of its graph.
+#include <gtest/gtest.h>
+
+#include "firmware/autonomy.hpp"
+
+namespace storey::firmware {
+namespace {
+
+ExplorationStatus exhausted(uint32_t nodes, uint32_t robot_part, uint32_t unreachable) {
+  ExplorationStatus s;
+  s.nodes = nodes;
+  s.robot_component_nodes = robot_part;
+  s.clusters = unreachable + 2;
+  s.clusters_set_aside = 2;
+  s.clusters_unreachable = unreachable;
+  return s;
+}
+
+// teaching_building seed 1, session 31: 293 of 300 clusters unreachable from a 3-node component
+// (of 1,580) claimed "complete". A floor climbed blind can be a part of its own (house seed 4,
+// session 32: the robot's 184 of 362 nodes): with a cluster unreachable below, still complete.
+// Nothing unreachable: complete however small the robot's part.
+TEST(Autonomy, AnExhaustedRunCutOffInASmallPartOfItsGraphIsStranded) {
+  EXPECT_TRUE(Autonomy::stranded(exhausted(1580, 3, 293)));
+  EXPECT_FALSE(Autonomy::stranded(exhausted(362, 184, 1)));
+  EXPECT_FALSE(Autonomy::stranded(exhausted(1580, 3, 0)));
+  EXPECT_TRUE(Autonomy::stranded(exhausted(1000, 99, 1)));
+  EXPECT_FALSE(Autonomy::stranded(exhausted(1000, 100, 1)));
+  EXPECT_STREQ(to_string(ExplorationState::kStranded), "stranded");
+}
+
+}  // namespace
+}  // namespace storey::firmware
