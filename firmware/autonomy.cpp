@@ -467,22 +467,9 @@ void Autonomy::control_step() {
     pending_.reset();
     brake_k_ = 1.0;
     entering_ = true;
-    hold_until_s_ = -1;
-    const Eigen::Vector2d at(last_pose_.x_m, last_pose_.y_m);
-    if (ctl_traj_ && !ctl_traj_->trajectory.empty()) {
-      tau_ = ControlLaw::entry_time(ctl_traj_->trajectory, at);
-      // plan.enter_at_rest: at rest off the new trajectory, the robot would cross to it through
-      // poses nobody checked: it holds still and the planner plans from where it stands. Once
-      // per place: a start moved off the robot on purpose (free_start) comes back the same.
-      constexpr double kEnterGapM = 0.15;
-      const double gap = (ctl_traj_->trajectory.sample(tau_).p_m.head<2>() - at).norm();
-      if (opt_.params.plan.enter_at_rest && last_pose_.velocity_world().norm() < 0.1 &&
-          gap > kEnterGapM && !((held_at_ - at).norm() < 0.05)) {
-        held_at_ = at;
-        hold_until_s_ = now + 1.0;
-        replan_request_.store(true, std::memory_order_release);
-      }
-    }
+    if (ctl_traj_ && !ctl_traj_->trajectory.empty())
+      tau_ = ControlLaw::entry_time(ctl_traj_->trajectory,
+                                    Eigen::Vector2d(last_pose_.x_m, last_pose_.y_m));
     lag_s_ = std::max(0.0, now - tau_);  // entered late (braking first, the plan's latency)
   };
   const auto tv = traj_.read();
@@ -538,8 +525,7 @@ void Autonomy::control_step() {
     ref.v_mps *= speed_k, ref.yaw_rate_rps *= speed_k;  // no faster than the robot can follow
     err = (ref.p_m - last_pose_.position()).head<2>().norm();
   }
-  const bool holding = has_traj && now < hold_until_s_;  // plan.enter_at_rest
-  const bool following = has_traj && !holding && (tau_ < tau_end || err > 0.15);
+  const bool following = has_traj && (tau_ < tau_end || err > 0.15);
 
   // FCL look-ahead over the next lookahead_s of the trajectory, on the latest map: re-checked
   // whenever the map or the trajectory changes (between changes the answer can only shift

@@ -277,10 +277,6 @@ class Autonomy {
   // old one's progress and feedforward scaled by brake_k_, falling 1 -> 0 at a_max from brake_v0_.
   std::shared_ptr<const PlannedTrajectory> pending_;
   double brake_k_ = 1.0, brake_v0_ = 0;
-  // plan.enter_at_rest: entered at rest further than kEnterGapM from it, a trajectory is held
-  // (zero command) until the replan asked for arrives, or hold_until_s_; once per place.
-  double hold_until_s_ = -1;
-  Eigen::Vector2d held_at_ = Eigen::Vector2d::Constant(NAN);
   bool collision_predicted_ = false;
   VelocityCommand prev_cmd_;
   PoseSample last_pose_;

@@ -153,9 +153,9 @@ struct PlanOptions {
   bool brake_along_motion = false;
   // Beyond the paper (session 32), the control task: a new trajectory that turns away from a
   // moving robot is entered once braked to rest on the one followed, wherever it starts (not
-  // only one starting on it ahead); and one entered at rest more than 0.15 m from the robot is
-  // held while the planner replans from where the robot stands. Entered at walking speed from
-  // behind, the body overshot 0.3 m past the new reference into a wall (office seed 3).
+  // only one starting on it ahead). Entered at walking speed from behind, the body overshot
+  // 0.3 m past the new reference into a wall (office seed 3 with
+  // safety.reference_speed_lead_mps).
   bool enter_at_rest = false;
   bool incremental_maintenance = true;
 };
