@@ -60,11 +60,13 @@ MapOptions bench_options() {
   return o;
 }
 
-void insert_storey(benchmark::State& state, bool vlp16, bool exact = false, bool crossing = false) {
+void insert_storey(benchmark::State& state, bool vlp16, bool exact = false, bool crossing = false,
+                   bool from_above = false) {
   const ScanSet& set = scans(vlp16);
   MapOptions o = bench_options();
   if (exact) o.ray_early_stop_voxels = 0;  // every voxel of every ray, like OctoMap
   o.miss_needs_crossing = crossing;        // map.miss_needs_crossing
+  o.floor_seen_from_above = from_above;    // map.floor_seen_from_above
   TraversabilityMap map(o);
   size_t i = 0, points = 0;
   for (auto _ : state) {
@@ -115,6 +117,13 @@ void BM_map_insert_vlp16_crossing(benchmark::State& s) {
 }
 void BM_map_insert_mid360_crossing(benchmark::State& s) {
   insert_storey(s, false, false, true);
+}
+// map.floor_seen_from_above (with the default miss_needs_crossing): each hit's rise.
+void BM_map_insert_vlp16_from_above(benchmark::State& s) {
+  insert_storey(s, true, false, true, true);
+}
+void BM_map_insert_mid360_from_above(benchmark::State& s) {
+  insert_storey(s, false, false, true, true);
 }
 void BM_map_insert_mid360_octomap(benchmark::State& s) {
   insert_octomap(s, false);
@@ -209,6 +218,12 @@ BENCHMARK(BM_map_insert_vlp16_crossing)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_map_insert_mid360_crossing)
     ->Name("map_insert_mid360/storey_crossing")
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_map_insert_vlp16_from_above)
+    ->Name("map_insert_vlp16/storey_crossing_from_above")
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_map_insert_mid360_from_above)
+    ->Name("map_insert_mid360/storey_crossing_from_above")
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_map_insert_vlp16_exact)
     ->Name("map_insert_vlp16/storey_exact")
