@@ -19,7 +19,7 @@ class StoreyPolicy final : public ExplorationPolicy {
   core::plan::ExplorationResult plan(const core::plan::ExplorationInput& in) override {
     return planner_.plan(in);
   }
-  void drop_target() override { planner_.local().drop_target(); }
+  void drop_target() override { planner_.drop_target(); }
   const core::plan::LocalPlanner* local_layer() const override {
     return &const_cast<core::plan::ExplorationPlanner&>(planner_).local();
   }

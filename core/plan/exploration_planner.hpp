@@ -98,6 +98,11 @@ class ExplorationPlanner {
   const HybridGraph& hybrid() const { return hybrid_; }
   const FloorTracker& floors() const { return floors_; }
   LocalPlanner& local() { return local_; }
+  // Forget the local target and the zone-centre drive (the control task asked for a replan).
+  void drop_target() {
+    local_.drop_target();
+    drive_end_s_ = -1.0;
+  }
   // Per-stage profiling (stage_probe.hpp); nullptr: none. Passed on to the hybrid graph and the
   // local layer. The probe must outlive the planner or be reset to nullptr.
   void set_stage_probe(StageProbe* probe);
@@ -121,6 +126,11 @@ class ExplorationPlanner {
   CollisionChecker checker_;
   StageProbe* probe_ = nullptr;
   bool hybrid_updated_last_ = false;  // the previous cycle ran the hybrid-graph maintenance
+  // The drive toward a zone centre last published (drive_to): its goal and its end on the
+  // trajectory's clock (-1: none).
+  Eigen::Vector3d drive_goal_m_ = Eigen::Vector3d::Zero();
+  double drive_end_s_ = -1.0;
+  bool drove_ = false;  // this cycle published a drive
   std::vector<int32_t> set_aside_zones_;
   // Scratch.
   std::vector<graph::FrontierCluster> sel_clusters_;
