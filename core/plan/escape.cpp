@@ -32,7 +32,11 @@ std::optional<StraightWalk> straight_walk(CollisionChecker& checker, const map::
       0.5 * std::min(robot.max_yaw_rate_rps * dt, robot.max_yaw_accel_rps2 * dt * dt), 1e-3);
   // The shorter way round only: the body box is centred on its foot and symmetric, so the longer
   // way sweeps every orientation the shorter one does.
-  const int m = std::abs(turn) > 0.1 ? int(std::ceil(std::abs(turn) / per_knot)) : 0;
+  // Below kTurnRad the tracking law turns the body while it walks, as without from_yaw: a level
+  // box turning on the spot on a flight (pitch 0 at a standing pose) meets the treads, and every
+  // climb going on from mid-flight a few degrees off its axis was refused (house seed 8).
+  constexpr double kTurnRad = 0.5;
+  const int m = std::abs(turn) > kTurnRad ? int(std::ceil(std::abs(turn) / per_knot)) : 0;
   std::vector<Eigen::Vector3d> c(3 + size_t(m), pts.front());  // tripled: starts exactly there
   std::vector<double> yaws(3, m > 0 ? from_yaw : yaw);
   for (int j = 1; j <= m; ++j) yaws.push_back(from_yaw + turn * double(j) / m);

@@ -28,7 +28,7 @@ struct StraightWalk {
 
 // A B-spline through pts at constant yaw, starting at t0 (knots at half the speed limit and the
 // acceleration limit at the ends), collision-checked; nullopt if it collides. With a finite
-// from_yaw (the robot's yaw) further than 0.1 rad from yaw, the walk first turns the body on the
+// from_yaw (the robot's yaw) further than 0.5 rad from yaw, the walk first turns the body on the
 // spot at pts.front() to yaw, the shorter way round, within half the yaw-rate and
 // yaw-acceleration limits: that turn is checked too. Without it the body turned on the spot
 // where the walk started, behind a reference that held still for it, through poses no check saw
