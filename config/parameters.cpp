@@ -197,6 +197,7 @@ void read_plan(SectionReader&& r, core::plan::PlanOptions& o) {
   r.get("turn_before_walk", o.turn_before_walk);
   r.get("brake_along_motion", o.brake_along_motion);
   r.get("enter_at_rest", o.enter_at_rest);
+  r.get("keep_zone_drive", o.keep_zone_drive);
   r.get("no_progress_s", o.no_progress_s, Range{0.0, 600.0});
   r.get("stale_floor_s", o.stale_floor_s, Range{0.0, 3600.0});
   r.get("replan_only_if_faster", o.replan_only_if_faster);

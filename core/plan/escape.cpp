@@ -33,8 +33,8 @@ std::optional<StraightWalk> straight_walk(CollisionChecker& checker, const map::
   // The shorter way round only: the body box is centred on its foot and symmetric, so the longer
   // way sweeps every orientation the shorter one does.
   // Below kTurnRad the tracking law turns the body while it walks, as without from_yaw: a level
-  // box turning on the spot on a flight (pitch 0 at a standing pose) meets the treads, and every
-  // climb going on from mid-flight a few degrees off its axis was refused (house seed 8).
+  // box turning on the spot on a flight (pitch 0 at a standing pose) meets the treads. From
+  // 0.1 rad, house seed 8 never reached its upper floor.
   constexpr double kTurnRad = 0.5;
   const int m = std::abs(turn) > kTurnRad ? int(std::ceil(std::abs(turn) / per_knot)) : 0;
   std::vector<Eigen::Vector3d> c(3 + size_t(m), pts.front());  // tripled: starts exactly there

@@ -134,12 +134,14 @@ void ExplorationPlanner::build_prior(const ExplorationInput& in, int32_t ref, in
 
 bool ExplorationPlanner::drive_to(const ExplorationInput& in, const Eigen::Vector3d& goal,
                                   ExplorationResult& r) {
-  // PlanOptions::target_momentum: the drive to the same goal is kept while its reference has more
+  // PlanOptions::keep_zone_drive: the drive to the same goal is kept while its reference has more
   // than a second to go. Each cycle's new drive started at rest where the robot was: the
   // reference never got up to speed, and the robot crawled toward the zone centre at 0.2-0.4 m/s
-  // (house seed 2, session 32: a new trajectory every 0.5 s for 18 s).
+  // (house seed 2, session 32: a new trajectory every 0.5 s for 18 s). Off: up to speed, the
+  // next drive (another goal) still starts at rest where the robot was, and the body ran 0.45 m
+  // past it (house seed 3).
   const double now = in.t_s - std::clamp(in.trajectory_lag_s, 0.0, LocalPlanner::kMaxReferenceLagS);
-  if (opt_.target_momentum && drive_end_s_ >= 0 && now < drive_end_s_ - 1.0 &&
+  if (opt_.keep_zone_drive && drive_end_s_ >= 0 && now < drive_end_s_ - 1.0 &&
       (goal - drive_goal_m_).norm() < 0.3) {
     r.status = ExplorationStatus::kKeep;
     return true;

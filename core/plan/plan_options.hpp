@@ -157,6 +157,9 @@ struct PlanOptions {
   // 0.3 m past the new reference into a wall (office seed 3 with
   // safety.reference_speed_lead_mps).
   bool enter_at_rest = false;
+  // Beyond the paper (session 32): the drive toward a zone centre (ExplorationPlanner::drive_to)
+  // is kept while its reference has more than a second to go, not planned anew each cycle.
+  bool keep_zone_drive = false;
   bool incremental_maintenance = true;
 };
 
