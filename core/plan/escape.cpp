@@ -50,6 +50,30 @@ std::optional<StraightWalk> straight_walk(CollisionChecker& checker, const map::
   return StraightWalk{std::move(t), pts.front(), pts.back()};
 }
 
+std::optional<Eigen::Vector3d> straight_rest_point(CollisionChecker& checker,
+                                                   const map::MapView& view,
+                                                   const RobotModel& robot,
+                                                   const Eigen::Vector3d& foot, double yaw,
+                                                   const Eigen::Vector2d& v, double t_s) {
+  const double d = v.squaredNorm() / (2.0 * std::max(robot.max_accel_mps2, 1e-3));
+  if (!std::isfinite(d) || d < 0.05) return std::nullopt;
+  const Eigen::Vector2d u = v.normalized();
+  std::vector<BodyPose> way;
+  double z = foot.z();
+  Eigen::Vector3d rest = foot;
+  for (double s = 0.05; s <= d + 1e-9; s += 0.05) {
+    const Eigen::Vector2d q = foot.head<2>() + std::min(s, d) * u;
+    const auto sp = view.support_surface_near(Eigen::Vector3f(float(q.x()), float(q.y()), float(z)),
+                                              robot.step_height_m);
+    if (sp && sp->state == map::TravState::kUntraversable) return std::nullopt;
+    if (sp) z = sp->height_m;
+    rest = Eigen::Vector3d(q.x(), q.y(), z);
+    for (double dyaw : {0.0, -0.6, 0.6}) way.push_back(BodyPose{rest, yaw + dyaw, 0.0, t_s});
+  }
+  if (way.empty() || checker.check_poses(view, way).collides) return std::nullopt;
+  return rest;
+}
+
 std::optional<StraightWalk> escape_to_turn(CollisionChecker& checker, const map::MapView& view,
                                            const RobotModel& robot, const Eigen::Vector3d& start,
                                            double yaw, double t0, double radius_m,

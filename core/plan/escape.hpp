@@ -38,6 +38,17 @@ std::optional<StraightWalk> straight_walk(CollisionChecker& checker, const map::
                                           const std::vector<Eigen::Vector3d>& pts, double yaw,
                                           double t0, double from_yaw = NAN);
 
+// Where a robot at foot moving at v (planar, world) comes to rest braking straight at the
+// acceleration limit (|v|^2 / (2 a_max) on), if the body is clear every 0.05 m on the way (at
+// yaw and 0.6 rad either side) over no untraversable support; the support's height where seen
+// (the LiDAR's blind ring is unseen: the robot goes there anyway). nullopt: under 0.05 m to rest,
+// or not clear.
+std::optional<Eigen::Vector3d> straight_rest_point(CollisionChecker& checker,
+                                                   const map::MapView& view,
+                                                   const RobotModel& robot,
+                                                   const Eigen::Vector3d& foot, double yaw,
+                                                   const Eigen::Vector2d& v, double t_s);
+
 // The straight step from start (yaw kept) to the nearest reachable pose within radius_m where
 // the body can turn, nearest first (0.1 m rings, 16 directions); with away_from, only poses that
 // gain distance from that point (at least half the step). nullopt: none.

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/plan/escape.hpp"
 #include "core/plan/path_centring.hpp"
 #include "core/plan/plan_config.hpp"
 
@@ -137,19 +138,26 @@ bool ExplorationPlanner::drive_to(const ExplorationInput& in, const Eigen::Vecto
   // PlanOptions::keep_zone_drive: the drive to the same goal is kept while its reference has more
   // than a second to go. Each cycle's new drive started at rest where the robot was: the
   // reference never got up to speed, and the robot crawled toward the zone centre at 0.2-0.4 m/s
-  // (house seed 2, session 32: a new trajectory every 0.5 s for 18 s). Off: up to speed, the
-  // next drive (another goal) still starts at rest where the robot was, and the body ran 0.45 m
-  // past it (house seed 3).
+  // (house seed 2, session 32: a new trajectory every 0.5 s for 18 s). Up to speed, the robot
+  // needs the next drive (another goal) to start where its braking ends (below).
   const double now = in.t_s - std::clamp(in.trajectory_lag_s, 0.0, LocalPlanner::kMaxReferenceLagS);
   if (opt_.keep_zone_drive && drive_end_s_ >= 0 && now < drive_end_s_ - 1.0 &&
       (goal - drive_goal_m_).norm() < 0.3) {
     r.status = ExplorationStatus::kKeep;
     return true;
   }
-  VoxelPath path = astar_.plan(*in.view, in.robot_foot_m, goal);
+  // With keep_zone_drive and brake_start, a moving robot's new drive starts where it comes to rest
+  // (as LocalPlanner::brake_start, straight along the velocity): started where the robot was, a
+  // drive entered at walking speed was overshot by 0.45 m (house seed 3, session 32).
+  Eigen::Vector3d start = in.robot_foot_m;
+  if (opt_.keep_zone_drive && opt_.brake_start && in.robot_velocity_mps.allFinite())
+    if (const auto rest = straight_rest_point(checker_, *in.view, robot_, in.robot_foot_m,
+                                              in.robot_yaw_rad, in.robot_velocity_mps, in.t_s))
+      start = *rest;
+  VoxelPath path = astar_.plan(*in.view, start, goal);
   if (path.status != VoxelAStarStatus::kOk || path.points_m.empty()) return false;
-  path.points_m.front() = in.robot_foot_m;
-  const Eigen::Vector2d d = (goal - in.robot_foot_m).head<2>();
+  path.points_m.front() = start;
+  const Eigen::Vector2d d = (goal - start).head<2>();
   const double yaw = shape_path(*in.view, path.points_m,
                                 d.norm() > 1e-6 ? std::atan2(d.y(), d.x()) : in.robot_yaw_rad);
   TrajectoryResult tr =

@@ -530,19 +530,9 @@ void LocalPlanner::brake_start(const LocalPlanInput& in) {
       way.clear();
     }
   }
-  const Eigen::Vector2d u = v.normalized();
-  double z = in.robot_foot_m.z();
-  for (double s = 0.05; s <= d + 1e-9; s += 0.05) {
-    const Eigen::Vector2d q = in.robot_foot_m.head<2>() + std::min(s, d) * u;
-    const auto sp = in.view->support_surface_near(
-        Eigen::Vector3f(float(q.x()), float(q.y()), float(z)), robot_.step_height_m);
-    if (sp && sp->state == map::TravState::kUntraversable) return;
-    if (sp) z = sp->height_m;  // else unseen (the LiDAR's blind ring): the robot goes there anyway
-    for (double dyaw : {0.0, -0.6, 0.6})
-      way.push_back(BodyPose{{q.x(), q.y(), z}, in.robot_yaw_rad + dyaw, 0.0, in.t_s});
-  }
-  if (way.empty() || checker_.check_poses(*in.view, way).collides) return;
-  start_foot_m_ = way.back().foot_m;
+  if (const auto rest = straight_rest_point(checker_, *in.view, robot_, in.robot_foot_m,
+                                            in.robot_yaw_rad, v, in.t_s))
+    start_foot_m_ = *rest;
 }
 
 bool LocalPlanner::no_progress(const LocalPlanInput& in) {
