@@ -101,6 +101,23 @@ TEST(Escape, AStraightWalkTurnsTheBodyOnTheSpotFirstAndChecksTheTurn) {
   EXPECT_NEAR(back->trajectory.pose(back->trajectory.t_end()).yaw_rad, 0.0, 1e-9);
 }
 
+// A moving robot comes to rest |v|^2 / (2 a_max) on along its velocity where the body is clear on
+// the way (LocalPlanner::brake_start, a new zone-centre drive); none toward a wall it would meet,
+// none for a robot all but at rest.
+TEST(Escape, AMovingRobotComesToRestStraightAlongItsVelocity) {
+  const map::TraversabilityMap m = corridor_into_room();
+  const map::MapView view = m.view();
+  const RobotModel robot;
+  CollisionChecker checker(robot, view.voxel_size_m());
+  const auto rest = straight_rest_point(checker, view, robot, {1.5, 0, 0}, 0.0, {0.8, 0.0}, 0.0);
+  ASSERT_TRUE(rest.has_value());
+  EXPECT_NEAR(rest->x(), 1.5 + 0.8 * 0.8 / (2 * robot.max_accel_mps2), 0.05) << rest->transpose();
+  EXPECT_NEAR(rest->y(), 0.0, 1e-9);
+  // 0.5 m from the room's far wall (x = 4) at 1 m/s: the body meets it on the way.
+  EXPECT_FALSE(straight_rest_point(checker, view, robot, {3.2, 0, 0}, 0.0, {1.0, 0.0}, 0.0));
+  EXPECT_FALSE(straight_rest_point(checker, view, robot, {1.5, 0, 0}, 0.0, {0.2, 0.0}, 0.0));
+}
+
 TEST(Escape, NearestFreeFootStepsAwayFromAWallItOverlaps) {
   const map::TraversabilityMap m = corridor_into_room();
   const map::MapView view = m.view();
