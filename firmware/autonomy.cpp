@@ -301,6 +301,7 @@ void Autonomy::plan_step() {
     if (cur.ptr && !cur.ptr->trajectory.empty()) publish(std::make_shared<PlannedTrajectory>());
   };
   ExplorationStatus s;
+  s.nodes = uint32_t(w.graph.node_count());  // before the switch: stranded() reads it
   if (r.floor_changed && r.floor >= 0)
     plan_q_.try_push(PlanEvent{PlanEvent::kFloor, now, r.floor, r.reference_floor, r.dz_m, "",
                                float(pose.x_m), float(pose.y_m), float(pose.z_m)});
@@ -360,7 +361,6 @@ void Autonomy::plan_step() {
       // Frontiers left that no real edge joins to a robot cut off in a small part of the graph:
       // not a building explored (teaching_building seed 1, session 31: 293 of 300 clusters
       // unreachable from a 3-node component on a phantom floor).
-      s.nodes = uint32_t(w.graph.node_count());
       stranded_ = complete_ && stranded(s);
       if (complete_ && !was_complete)
         plan_q_.try_push(PlanEvent{stranded_ ? PlanEvent::kStranded : PlanEvent::kComplete, now,
@@ -376,7 +376,6 @@ void Autonomy::plan_step() {
   s.method = policy_->name();
   s.last_plan = r.status;
   s.plan_reason = r.reason;
-  s.nodes = uint32_t(w.graph.node_count());
   s.edges = uint32_t(w.graph.edge_count());
   s.frontier_nodes = w.frontier_nodes;
   s.clusters = uint32_t(w.clusters.size());

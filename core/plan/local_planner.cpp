@@ -488,7 +488,6 @@ void LocalPlanner::brake_start(const LocalPlanInput& in) {
   const Eigen::Vector2d v = in.robot_velocity_mps;
   const double d = v.squaredNorm() / (2.0 * std::max(robot_.max_accel_mps2, 1e-3));
   if (!std::isfinite(d) || d < 0.05) return;
-  std::vector<BodyPose> way;
   // On the trajectory followed: from its point nearest the robot (within 0.3 m), d of arc on.
   if (!current_.empty()) {
     double s0 = NAN, best = 0.3;
@@ -499,6 +498,7 @@ void LocalPlanner::brake_start(const LocalPlanInput& in) {
       if (e < best) best = e, s0 = s;
     }
     if (std::isfinite(s0)) {
+      std::vector<BodyPose> way;
       double arc = 0, next = 0.05;
       Eigen::Vector3d prev = current_.sample(s0).p_m;
       for (double s = s0 + 0.02; s <= current_.t_end() + 1e-9 && arc < d; s += 0.02) {
@@ -527,7 +527,6 @@ void LocalPlanner::brake_start(const LocalPlanInput& in) {
         start_yaw_ = way.back().yaw_rad;
         return;
       }
-      way.clear();
     }
   }
   if (const auto rest = straight_rest_point(checker_, *in.view, robot_, in.robot_foot_m,
