@@ -21,6 +21,18 @@ const char* to_string(ExplorationState s) {
   return "unknown";
 }
 
+std::string describe_target(const ExplorationStatus& s) {
+  if (!s.has_target) return {};
+  char b[96];
+  if (s.target_cluster >= 0)
+    std::snprintf(b, sizeof b, "  -> cluster %d at %.1f, %.1f, %.1f", s.target_cluster,
+                  s.target_x_m, s.target_y_m, s.target_z_m);
+  else
+    std::snprintf(b, sizeof b, "  -> goal at %.1f, %.1f, %.1f", s.target_x_m, s.target_y_m,
+                  s.target_z_m);
+  return b;
+}
+
 namespace {
 constexpr const char* kTaskNames[] = {"ingest", "map", "plan", "control", "watchdog", "telemetry"};
 
@@ -386,6 +398,13 @@ void Autonomy::plan_step() {
   }
   s.trajectories = trajectories_;
   s.plan_cycles = plan_cycles_;
+  if (const auto cur = traj_.read(); cur.ptr && !cur.ptr->trajectory.empty()) {
+    s.has_target = true;
+    s.target_cluster = cur.ptr->target_cluster;
+    s.target_x_m = float(cur.ptr->target_m.x());
+    s.target_y_m = float(cur.ptr->target_m.y());
+    s.target_z_m = float(cur.ptr->target_m.z());
+  }
   s.floor_hint = int(std::lround(pose.z_m / opt_.params.graph.floor_height_hint_m));
   s.floor = r.floor;
   s.guided = r.guided;

@@ -100,8 +100,14 @@ struct ExplorationStatus {
   double prior_dz_m = 0;
   uint32_t zones = 0, zones_left = 0, zones_deferred = 0;
   bool guided = false;
+  // The published trajectory's goal (what the robot is heading for; -1: none or a zone drive).
+  bool has_target = false;
+  int32_t target_cluster = -1;
+  float target_x_m = 0, target_y_m = 0, target_z_m = 0;  // Mailbox: trivially copyable
 };
 const char* to_string(ExplorationState s);
+// "  -> cluster 12 at 3.0, 4.5, 0.0" (or "" without a target): for progress lines.
+std::string describe_target(const ExplorationStatus& s);
 
 // Plan task -> telemetry (non-RT log): floor changes, prior built, failures, completion.
 struct PlanEvent {

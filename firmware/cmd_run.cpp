@@ -264,11 +264,11 @@ int cmd_run(int argc, char** argv) {
       std::fprintf(
           stderr,
           "[run %6.1f s] %-9s scans %llu  packets %llu (dropped %llu)  pose %.2f,%.2f,%.2f "
-          "yaw %.0f  nodes %u  frontiers %u  stops %llu [%s]\n",
+          "yaw %.0f  nodes %u  frontiers %u  stops %llu [%s]%s\n",
           t, to_string(st.state), (unsigned long long)pc.scans, (unsigned long long)lc.datagrams,
           (unsigned long long)drops, p.x_m, p.y_m, p.z_m, p.yaw_rad * 180 / M_PI, st.nodes,
           st.frontier_nodes, (unsigned long long)autonomy.safety_stops(),
-          mask_names(autonomy.active_stop_mask()).c_str());
+          mask_names(autonomy.active_stop_mask()).c_str(), describe_target(st).c_str());
     }
     if (const int sig = g_signal.load()) {
       summary.end_reason = std::string("stopped by ") + (sig == SIGINT ? "SIGINT" : "SIGTERM");

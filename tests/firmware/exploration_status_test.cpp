@@ -30,5 +30,19 @@ TEST(Autonomy, AnExhaustedRunCutOffInASmallPartOfItsGraphIsStranded) {
   EXPECT_STREQ(to_string(ExplorationState::kStranded), "stranded");
 }
 
+// The progress lines name what the robot heads for: a cluster, a goal toward a zone, or nothing.
+TEST(Autonomy, ProgressNamesTheTarget) {
+  ExplorationStatus s;
+  EXPECT_EQ(describe_target(s), "");
+  s.has_target = true;
+  s.target_cluster = 12;
+  s.target_x_m = 3.04f;
+  s.target_y_m = -4.5f;
+  s.target_z_m = 3.0f;
+  EXPECT_EQ(describe_target(s), "  -> cluster 12 at 3.0, -4.5, 3.0");
+  s.target_cluster = -1;
+  EXPECT_EQ(describe_target(s), "  -> goal at 3.0, -4.5, 3.0");
+}
+
 }  // namespace
 }  // namespace storey::firmware

@@ -440,10 +440,11 @@ SimRunResult run_exploration(const SimRunOptions& opt) {
         std::snprintf(
             line, sizeof line,
             "[sim %7.1f s] coverage %5.1f %%  floor %d  nodes %u  frontiers %u (clusters %u)"
-            "  stops %llu  plan %s (%s)",
+            "  stops %llu  plan %s (%s)%s",
             t, 100 * c.traversable_coverage, st.floor_hint, st.nodes, st.frontier_nodes,
             st.clusters, (unsigned long long)autonomy.safety_stops(),
-            core::plan::to_string(st.last_plan), st.plan_reason);
+            core::plan::to_string(st.last_plan), st.plan_reason,
+            firmware::describe_target(st).c_str());
         progress(line);
       }
       if (done) {
