@@ -201,6 +201,7 @@ class Autonomy {
     return policy_->local_layer() ? *policy_->local_layer() : *idle_local_;
   }
   const ExplorationPolicy& policy() const { return *policy_; }
+  const config::Parameters& params() const { return opt_.params; }
 
  private:
   enum Task { kIngest = 0, kMap, kPlan, kControl, kWatchdog, kTelemetry, kTaskCount };

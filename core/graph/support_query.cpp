@@ -211,6 +211,7 @@ SupportQuery::ProbeSegment SupportQuery::probe_segment(const Eigen::Vector3f& fr
           r.closed = r.hole = true;
           return false;
         }
+        if (*unknown_run == 0) r.run_start = k;
         ++*unknown_run;
         return true;
     }
@@ -259,7 +260,7 @@ bool SupportQuery::wall_face(const Support& top, const Eigen::Vector2f& dir) {
 bool SupportQuery::probe_open_climbing(const Eigen::Vector3f& foot, const Eigen::Vector2f& dir,
                                        float length_m, float height_m, float min_free_m,
                                        float min_unknown_m, bool* climbed, bool* leaves_reach,
-                                       bool* blocked) {
+                                       bool* blocked, ProbeWhy* why) {
   constexpr int kMaxClimbs = 24;
   if (climbed) *climbed = false;
   if (blocked) *blocked = false;
@@ -282,6 +283,14 @@ bool SupportQuery::probe_open_climbing(const Eigen::Vector3f& foot, const Eigen:
     if (open && climbed && opt_.ramp_frontiers && gradual >= step_) *climbed = true;
     return open;
   };
+  auto centre = [&](const VoxelKey& k) {
+    return Eigen::Vector3f((float(k.x) + 0.5f) * vs_, (float(k.y) + 0.5f) * vs_,
+                           (float(k.z) + 0.5f) * vs_);
+  };
+  auto opened_by = [&](OpenBy by, const Eigen::Vector3f& at) {
+    if (why) *why = {by, at};
+  };
+  if (why) *why = {};
   for (int climb = 0; climb <= kMaxClimbs && s0 < reach(); ++climb) {
     const float s_end = reach();
     const Eigen::Vector3f from(foot.x() + dir.x() * s0, foot.y() + dir.y() * s0, zc + height_m);
@@ -289,7 +298,10 @@ bool SupportQuery::probe_open_climbing(const Eigen::Vector3f& foot, const Eigen:
     const ProbeSegment seg = probe_segment(from, to, need_free, &free_total, &unknown_run);
     if (blocked) *blocked = seg.hole;
     if (seg.closed) return false;
-    if (!seg.hit) return open_end(unknown_run >= need_unknown);
+    if (!seg.hit) {
+      if (unknown_run >= need_unknown) opened_by(OpenBy::kUnknownRun, centre(seg.run_start));
+      return open_end(unknown_run >= need_unknown);
+    }
     const VoxelKey& hit = seg.hit_key;
     const float hx = (float(hit.x) + 0.5f) * vs_, hy = (float(hit.y) + 0.5f) * vs_;
     const float s_hit = (Eigen::Vector2f(hx, hy) - foot.head<2>()).dot(dir);
@@ -305,7 +317,10 @@ bool SupportQuery::probe_open_climbing(const Eigen::Vector3f& foot, const Eigen:
       const bool stair = rise >= kStairGrade * std::max(s_hit - s_climb, vs_);
       if (stair && ++stair_steps >= kStairSteps && climbed) *climbed = true;
       if (!stair) gradual += rise;
-      if (top->state == TravState::kUnobserved) return open_end(free_total >= need_free);
+      if (top->state == TravState::kUnobserved) {
+        if (free_total >= need_free) opened_by(OpenBy::kUnobservedStep, top->p_m);
+        return open_end(free_total >= need_free);
+      }
       if (leaves_reach && stair_steps >= kStairSteps && !top->reachable) *leaves_reach = true;
       zc = top->p_m.z();
       s_climb = s_hit;
@@ -316,7 +331,11 @@ bool SupportQuery::probe_open_climbing(const Eigen::Vector3f& foot, const Eigen:
     // Unknown right above the obstacle (within two voxels): terrain beyond a step not yet seen.
     for (int32_t dz = 1; dz <= 2; ++dz) {
       const Occupancy o = occupancy({hit.x, hit.y, hit.z + dz});
-      if (o == Occupancy::kUnknown) return open_end(free_total >= need_free);
+      if (o == Occupancy::kUnknown) {
+        if (free_total >= need_free)
+          opened_by(OpenBy::kUnknownOverObstacle, centre({hit.x, hit.y, hit.z + dz}));
+        return open_end(free_total >= need_free);
+      }
       if (o == Occupancy::kFree) break;
     }
     if (blocked) *blocked = true;

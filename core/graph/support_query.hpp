@@ -105,10 +105,16 @@ class SupportQuery {
   // *leaves_reach: the probe climbed a flight (two stair steps) onto support out of C_reach.
   // *blocked: a closed probe ended at an obstacle it could not climb or at a hole in a surface
   // (close_probes_at_holes): a wall.
+  // *why (diagnostics, optional): which unknown opened the probe and where.
+  enum class OpenBy : uint8_t { kNone = 0, kUnknownRun, kUnobservedStep, kUnknownOverObstacle };
+  struct ProbeWhy {
+    OpenBy by = OpenBy::kNone;
+    Eigen::Vector3f at_m = Eigen::Vector3f::Zero();  // the unknown run's first voxel / the step
+  };
   bool probe_open_climbing(const Eigen::Vector3f& foot, const Eigen::Vector2f& dir, float length_m,
                            float height_m, float min_free_m, float min_unknown_m,
                            bool* climbed = nullptr, bool* leaves_reach = nullptr,
-                           bool* blocked = nullptr);
+                           bool* blocked = nullptr, ProbeWhy* why = nullptr);
 
   const map::MapView& view() const { return view_; }
   float voxel_size() const { return vs_; }
@@ -122,6 +128,7 @@ class SupportQuery {
     bool hit = false, closed = false;
     bool hole = false;  // closed at a hole in a surface (close_probes_at_holes): a wall
     map::VoxelKey hit_key{};
+    map::VoxelKey run_start{};  // first voxel of the unknown run this leg began or extended
   };
   ProbeSegment probe_segment(const Eigen::Vector3f& from, const Eigen::Vector3f& to, int need_free,
                              int* free_total, int* unknown_run);

@@ -67,7 +67,8 @@ float TopologicalFrontiers::missing_surface_ratio(SupportQuery& q, const GraphNo
 // probe_unknown_m of it) without hitting an obstacle first. *up counts the open probes that
 // climbed first.
 int TopologicalFrontiers::open_directions(SupportQuery& q, const ReachableGraph& g, NodeId i,
-                                          int* up, int* leads, int* passages) {
+                                          int* up, int* leads, int* passages,
+                                          std::vector<ProbeExplanation>* explained) {
   const GraphNode& n = g.node(i);
   const int probes = std::max(1, opt_.probes);
   const float half = float(opt_.alpha_min_rad) * 0.5f;
@@ -76,6 +77,7 @@ int TopologicalFrontiers::open_directions(SupportQuery& q, const ReachableGraph&
   *up = 0;
   if (leads) *leads = 0;
   probe_state_.assign(size_t(probes), ProbeState::kOther);
+  if (explained) explained->assign(size_t(probes), {});
   for (int k = 0; k < probes; ++k) {
     const float th = 2.0f * float(M_PI) * float(k) / float(probes);
     bool covered = false;
@@ -85,15 +87,24 @@ int TopologicalFrontiers::open_directions(SupportQuery& q, const ReachableGraph&
       diff = std::remainder(diff, 2.0f * float(M_PI));
       covered = std::abs(diff) < half;
     }
+    if (explained) {
+      (*explained)[size_t(k)].theta_rad = th;
+      (*explained)[size_t(k)].covered = covered;
+    }
     if (covered) continue;
     bool climbed = false, out_of_reach = false, blocked = false;
-    const bool o = q.probe_open_climbing(n.p_m, Eigen::Vector2f(std::cos(th), std::sin(th)),
-                                         float(opt_.probe_length_m), float(opt_.probe_height_m),
-                                         min_free, float(opt_.probe_unknown_m), &climbed,
-                                         leads ? &out_of_reach : nullptr, &blocked);
+    SupportQuery::ProbeWhy why;
+    const bool o = q.probe_open_climbing(
+        n.p_m, Eigen::Vector2f(std::cos(th), std::sin(th)), float(opt_.probe_length_m),
+        float(opt_.probe_height_m), min_free, float(opt_.probe_unknown_m), &climbed,
+        leads ? &out_of_reach : nullptr, &blocked, explained ? &why : nullptr);
     probe_state_[size_t(k)] = o         ? ProbeState::kOpen
                               : blocked ? ProbeState::kBlocked
                                         : ProbeState::kOther;
+    if (explained) {
+      (*explained)[size_t(k)].state = probe_state_[size_t(k)];
+      (*explained)[size_t(k)].why = why;
+    }
     open += o;
     *up += o && climbed;
     if (leads) *leads += out_of_reach;
@@ -172,6 +183,16 @@ void TopologicalFrontiers::evaluate_flags(ReachableGraph& g, SupportQuery& q, No
 void TopologicalFrontiers::evaluate(ReachableGraph& g, const map::MapView& view, NodeId i) {
   SupportQuery q(view, opt_);
   evaluate(g, q, i);
+}
+
+std::vector<ProbeExplanation> TopologicalFrontiers::explain(const ReachableGraph& g,
+                                                            const map::MapView& view, NodeId i) {
+  std::vector<ProbeExplanation> out;
+  if (i >= g.node_capacity() || !g.node(i).alive) return out;
+  SupportQuery q(view, opt_);
+  int up = 0, leads = 0, passages = 0;
+  open_directions(q, g, i, &up, &leads, &passages, &out);
+  return out;
 }
 
 FrontierUpdateStats TopologicalFrontiers::update(ReachableGraph& g, const map::MapView& view,

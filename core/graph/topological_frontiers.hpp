@@ -20,6 +20,7 @@
 #include <Eigen/Core>
 
 #include "core/graph/reachable_graph.hpp"
+#include "core/graph/support_query.hpp"
 
 namespace storey::core::graph {
 
@@ -40,6 +41,14 @@ enum class ProbeState : uint8_t { kOther = 0, kOpen, kBlocked };
 // one of them count).
 int passage_probes(std::span<const ProbeState> ring);
 
+// One C_exp probe of a node, explained (diagnostics: why a node is a frontier).
+struct ProbeExplanation {
+  float theta_rad = 0;
+  bool covered = false;  // along an edge (within alpha_min / 2): not cast
+  ProbeState state = ProbeState::kOther;
+  SupportQuery::ProbeWhy why;  // for an open probe
+};
+
 class TopologicalFrontiers {
  public:
   explicit TopologicalFrontiers(const GraphOptions& opt = {});
@@ -59,13 +68,17 @@ class TopologicalFrontiers {
   }
   // Evaluates one node now (also used by tests): writes rho, open_dirs and the flags.
   void evaluate(ReachableGraph& g, const map::MapView& view, NodeId i);
+  // Every C_exp probe of node i as evaluate() casts it now (the graph is not changed).
+  std::vector<ProbeExplanation> explain(const ReachableGraph& g, const map::MapView& view,
+                                        NodeId i);
   bool idle() const { return queue_.empty(); }
 
  private:
   float missing_surface_ratio(SupportQuery& q, const GraphNode& n, int* samples);  // Eq. 5
   // *passages (optional): passage_probes() of the probes cast (GraphOptions::passage_frontiers).
   int open_directions(SupportQuery& q, const ReachableGraph& g, NodeId i, int* up,
-                      int* leads = nullptr, int* passages = nullptr);
+                      int* leads = nullptr, int* passages = nullptr,
+                      std::vector<ProbeExplanation>* explained = nullptr);
   bool near_reach_boundary(SupportQuery& q, const GraphNode& n);
   void evaluate(ReachableGraph& g, SupportQuery& q, NodeId i);
   void evaluate_flags(ReachableGraph& g, SupportQuery& q, NodeId i);

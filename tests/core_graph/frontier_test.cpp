@@ -110,6 +110,47 @@ TEST(TopologicalFrontiers, WallKeepsFrontierGroupsInSeparateClusters) {
       }());
 }
 
+// explain() (the run record's diagnostics) casts the probes evaluate() casts: as many open as
+// open_dirs, and each open probe names unknown space the map really holds (a run into it, or just
+// over an obstacle) within a probe's length; probes along edges are not cast.
+TEST(TopologicalFrontiers, ExplainNamesTheUnknownThatOpensEachProbe) {
+  const World w = split_room();
+  GraphOptions o;
+  Harness h(o);
+  observe_split_room(h, w);
+  const ReachableGraph& g = h.graph;
+  TopologicalFrontiers tf(o);
+  const float vs = float(h.map.view().voxel_size_m());
+  int checked = 0;
+  for (NodeId i = 0; i < g.node_capacity(); ++i) {
+    const GraphNode& n = g.node(i);
+    if (!n.alive || !n.c_exp) continue;
+    const auto probes = tf.explain(g, h.map.view(), i);
+    ASSERT_EQ(probes.size(), size_t(o.probes));
+    int open = 0;
+    for (const ProbeExplanation& p : probes) {
+      if (p.covered) EXPECT_EQ(p.state, ProbeState::kOther);
+      if (p.state != ProbeState::kOpen) {
+        EXPECT_EQ(p.why.by, SupportQuery::OpenBy::kNone);
+        continue;
+      }
+      ++open;
+      ASSERT_NE(p.why.by, SupportQuery::OpenBy::kNone);
+      const Vector3f& a = p.why.at_m;
+      EXPECT_LE((a - n.p_m).head<2>().norm(), float(o.probe_length_m) + 2 * vs);
+      if (p.why.by != SupportQuery::OpenBy::kUnobservedStep) {
+        const storey::core::map::VoxelKey k{int32_t(std::floor(a.x() / vs)),
+                                            int32_t(std::floor(a.y() / vs)),
+                                            int32_t(std::floor(a.z() / vs))};
+        EXPECT_EQ(h.map.view().occupancy(k), storey::core::map::Occupancy::kUnknown);
+      }
+    }
+    EXPECT_EQ(open, int(n.open_dirs));
+    ++checked;
+  }
+  EXPECT_GT(checked, 0) << "scenario: no C_exp node";
+}
+
 TEST(TopologicalFrontiers, StableClusterIdsAcrossUpdates) {
   const World w = split_room();
   Harness h;

@@ -6,6 +6,8 @@
 #include <map>
 #include <unordered_set>
 
+#include "core/graph/topological_frontiers.hpp"
+
 namespace storey::tools::sim {
 
 namespace {
@@ -81,6 +83,31 @@ std::string exploration_diagnostics(const firmware::Autonomy& autonomy, const Gr
                " |\n";
       }
     out += "\n";
+    // Why each C_exp node is open, probe by probe (a frontier that no view resolves shows here).
+    core::graph::TopologicalFrontiers tf(autonomy.params().graph);
+    const core::map::MapView view = autonomy.map_for_record().view();
+    std::string probes;
+    for (const auto& c : w->clusters)
+      for (core::graph::NodeId id : c.nodes) {
+        if (!g.node(id).c_exp) continue;
+        std::string row;
+        for (const auto& p : tf.explain(g, view, id)) {
+          if (p.state != core::graph::ProbeState::kOpen) continue;
+          using By = core::graph::SupportQuery::OpenBy;
+          const char* by = p.why.by == By::kUnknownRun            ? "unknown from"
+                           : p.why.by == By::kUnobservedStep      ? "under-observed step at"
+                           : p.why.by == By::kUnknownOverObstacle ? "unknown over an obstacle at"
+                                                                  : "open";
+          row += f("; %.0f deg: ", p.theta_rad * 180 / M_PI) + by +
+                 f(" %.2f, %.2f, %.2f", p.why.at_m.x(), p.why.at_m.y(), p.why.at_m.z());
+        }
+        if (!row.empty()) probes += "- node " + std::to_string(id) + row.substr(1) + "\n";
+      }
+    if (!probes.empty())
+      out +=
+          "Open C_exp probes of the frontier nodes (direction: the unknown that opens it, "
+          "at the probe's height):\n\n" +
+          probes + "\n";
   }
   std::map<std::string, int> reasons;
   for (const auto& e : planner.set_aside()) ++reasons[core::plan::to_string(e.reason)];
