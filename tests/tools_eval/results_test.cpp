@@ -36,6 +36,38 @@ TEST(Results, StatIsMeanAndSampleStd) {
   EXPECT_EQ(format_stat(Stat{}, 0, "none"), "none");
 }
 
+// Table II's per-floor times, as the paper's: the robot's time on the floor until it was explored,
+// from tracking.csv; the stair transitions and a visit to the other floor are left out.
+TEST(Results, FloorTimeIsTheTimeOnTheFloorFromTrackingCsv) {
+  const std::string dir = test::fresh_dir("onfloor");
+  test::write_run(dir, test::fixture_metrics(600, 470, 271, 495), "exploration complete");
+  auto r = read_metrics_json(dir + "/metrics.json", nullptr);
+  ASSERT_TRUE(r);
+  EXPECT_FALSE(add_time_on_floor(dir + "/none.csv", *r));
+  EXPECT_TRUE(std::isnan(r->per_floor[0].time_on_floor_s));
+  EXPECT_DOUBLE_EQ(floor_time(*r, 1), 224.0);  // without tracking: from the 1st floor's 90 %
+  // Floor 0 until 200 s, up (10 s), floor 1 until 250 s, down (10 s), floor 0 until 300 s, up
+  // (20 s), floor 1 to the end; 10 Hz.
+  std::ostringstream csv;
+  csv << "t_s,x_m,y_m,z_m,yaw_deg\n";
+  for (int i = 0; i <= 6000; ++i) {
+    const double t = 0.1 * i;
+    const bool up = (t > 200 && t < 210) || (t > 250 && t < 260) || (t > 300 && t < 320);
+    const double z = up ? 1.5 : ((t >= 210 && t <= 250) || t >= 320 ? 3.0 : 0.0);
+    csv << t << ",1.0,2.0," << z << ",0\n";
+  }
+  test::write_text(dir + "/tracking.csv", csv.str());
+  ASSERT_TRUE(add_time_on_floor(dir + "/tracking.csv", *r));
+  EXPECT_NEAR(r->per_floor[0].time_on_floor_s, 200.0 + 11.0, 0.25);  // [0, 271]
+  EXPECT_NEAR(r->per_floor[1].time_on_floor_s, 40.0 + 175.0, 0.25);  // [0, 495]
+  EXPECT_NEAR(floor_time(*r, 0), 211.0, 0.25);
+  EXPECT_NEAR(floor_time(*r, 1), 215.0, 0.25);
+  // load_outcome reads it with the record.
+  const RunOutcome o = load_outcome(RunSpec{}, dir);
+  ASSERT_EQ(o.status, RunStatus::finished);
+  EXPECT_NEAR(o.metrics.per_floor[1].time_on_floor_s, 215.0, 0.25);
+}
+
 TEST(Results, ReadsTheSimulatorsMetricsJson) {
   const std::string dir = test::fresh_dir("read");
   sim::RunMetrics m = test::fixture_metrics(530, 470, 271, 495);

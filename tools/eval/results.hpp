@@ -27,9 +27,10 @@ struct RunGroup {
 };
 std::vector<RunGroup> group_runs(const std::vector<RunOutcome>& outcomes);
 
-// Per-floor times as reported in Table II: floor f's time to 90 % coverage; for f >= 1 the time
-// from the previous floor's 90 % to this one's (the paper excludes transitions; we cannot, see
-// tools/eval/README.md). Negative when not reached.
+// Per-floor times as reported in Table II: the robot's time on floor f until the floor reached 90 %
+// (FloorRecord::time_on_floor_s; transitions excluded, as in the paper). A record without
+// tracking.csv: floor f's time to 90 %, for f >= 1 from the previous floor's 90 % (transitions
+// included). Negative when not reached.
 double floor_time(const MetricsRecord& m, size_t f);
 
 // "530 ± 17" (decimals after the point), or `empty` when there is no value.

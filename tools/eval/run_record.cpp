@@ -1,5 +1,7 @@
 #include "tools/eval/run_record.hpp"
 
+#include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -124,6 +126,31 @@ double last_simulated_time(const std::string& path) {
   return end && end != tail.c_str() + at + 5 && t >= 0 ? t : -1.0;
 }
 
+bool add_time_on_floor(const std::string& path, MetricsRecord& m) {
+  std::ifstream f(path);
+  if (!f) return false;
+  std::string line;
+  std::getline(f, line);  // header
+  std::vector<double> on(m.per_floor.size(), 0.0);
+  double prev_t = -1;
+  size_t samples = 0;
+  while (std::getline(f, line)) {
+    double t = 0, x = 0, y = 0, z = 0;
+    if (std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf", &t, &x, &y, &z) != 4) continue;
+    const double dt = prev_t >= 0 && t > prev_t ? t - prev_t : 0.0;
+    prev_t = t;
+    ++samples;
+    for (size_t i = 0; i < m.per_floor.size(); ++i) {
+      const FloorRecord& fl = m.per_floor[i];
+      if (fl.time_s >= 0 && t <= fl.time_s && std::abs(z - fl.z_m) <= kOnFloorM) on[i] += dt;
+    }
+  }
+  if (samples == 0) return false;
+  for (size_t i = 0; i < m.per_floor.size(); ++i)
+    m.per_floor[i].time_on_floor_s = m.per_floor[i].time_s >= 0 ? on[i] : std::nan("");
+  return true;
+}
+
 const char* to_string(RunStatus s) {
   switch (s) {
     case RunStatus::finished:
@@ -151,6 +178,7 @@ RunOutcome load_outcome(const RunSpec& spec, const std::string& dir) {
   std::string err;
   if (auto m = read_metrics_json(dir + "/metrics.json", &err)) {
     o.metrics = std::move(*m);
+    add_time_on_floor(dir + "/tracking.csv", o.metrics);
     o.status = RunStatus::finished;
     o.reason = o.metrics.end_reason.empty() ? read_report_outcome(dir + "/report.md")
                                             : o.metrics.end_reason;

@@ -17,6 +17,10 @@ struct FloorRecord {
   double z_m = 0.0;
   double time_s = -1.0;  // first time the floor reached 90 % coverage; < 0 = never
   double traversable_coverage = 0.0;
+  // Of [0, time_s], the time the robot stood on this floor (paper Table II: "complete exploration
+  // within each floor, excluding cross-floor transitions"); from tracking.csv; NaN when the
+  // record has no tracking.csv or the floor never reached 90 %.
+  double time_on_floor_s = std::nan("");
 };
 
 struct MetricsRecord {
@@ -38,6 +42,11 @@ struct MetricsRecord {
 // A metrics.json is complete when it parses as a whole and holds every field above (a record cut
 // off while being written does not parse). nullopt with *error naming the file otherwise.
 std::optional<MetricsRecord> read_metrics_json(const std::string& path, std::string* error);
+// Fills each floor's time_on_floor_s from a tracking.csv (t_s, x_m, y_m, z_m, ... at a fixed
+// rate; the robot is on a floor when its foot lies within kOnFloorM of the floor's z). False (and
+// nothing changed) when the file is missing or has no sample.
+constexpr double kOnFloorM = 0.3;
+bool add_time_on_floor(const std::string& tracking_csv_path, MetricsRecord& m);
 // The reason after "Outcome: **...** - " in report.md; "" when there is none.
 std::string read_report_outcome(const std::string& report_md_path);
 // The last non-empty line of a text file (a failed child's reason); "" when none.
