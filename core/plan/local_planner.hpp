@@ -98,6 +98,12 @@ enum class SetAsideReason : uint8_t {
 };
 const char* to_string(SetAsideReason r);
 
+// The order in which clusters with no path along G_real are tried on the map
+// (PlanOptions::reach_off_graph), given their representatives' positions: those on the robot's
+// level (|dz| <= band_m) first, nearest first within each group.
+std::vector<size_t> off_graph_order(const std::vector<Eigen::Vector3f>& reps_m,
+                                    const Eigen::Vector3f& robot_m, float band_m);
+
 // "No collision point": NaN (SetAsideEntry::hit_m and LocalPlanner's last Stage 3 hit).
 inline const Eigen::Vector3f kNoHitM =
     Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());

@@ -1448,6 +1448,22 @@ TEST(LocalPlanner, FrontiersWithNoPathAlongTheGraphAreReachedOnTheMapWithReachOf
   EXPECT_GT(on.end_x_m, 5.5);  // through the opening
 }
 
+// The off-graph clusters are tried on the robot's level first (office seed 5, session 33: a
+// cluster on the floor below, nearest in 3D, spent every cycle's Stage 3 attempts), nearest
+// first within each level.
+TEST(LocalPlanner, OffGraphClustersOnTheRobotsLevelAreTriedFirst) {
+  const Eigen::Vector3f robot(13.2f, 12.2f, 3.0f);
+  const std::vector<Eigen::Vector3f> reps = {
+      {17.3f, 7.4f, 0.0f},   // the floor below, 7.2 m away
+      {4.9f, 8.1f, 3.0f},    // the robot's floor, 9.3 m away
+      {21.4f, 13.9f, 2.8f},  // the flight's top, within the band
+      {12.0f, 11.0f, 0.2f},  // below, 3.1 m away
+      {9.0f, 12.0f, 3.3f}};  // the robot's floor, 4.2 m away
+  const std::vector<size_t> order = off_graph_order(reps, robot, 0.6f);
+  EXPECT_EQ(order, (std::vector<size_t>{4, 2, 1, 3, 0}));
+  EXPECT_EQ(off_graph_order({}, robot, 0.6f).size(), 0u);
+}
+
 namespace {
 // The corridor with the gate, scanned from the origin: the easternmost cluster (the graph stops
 // at the gate) and a viewpoint of it at `at` (on the graph node nearest it) facing `yaw`.
