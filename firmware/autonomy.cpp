@@ -330,6 +330,14 @@ void Autonomy::plan_step() {
       p->target_m = r.target_m;
       publish(std::move(p));
       ++trajectories_;
+      if (opt_.plan_log) {
+        PlanEvent e{PlanEvent::kTrajectory, now, r.floor, -1, 0, r.reason};
+        e.x_m = float(r.target_m.x());
+        e.y_m = float(r.target_m.y());
+        e.z_m = float(r.target_m.z());
+        e.cluster = r.target_cluster;
+        plan_q_.try_push(e);
+      }
       idle_since_s_ = -1;
       complete_ = false;
       break;
@@ -642,6 +650,16 @@ void Autonomy::telemetry_step() {
   }
   PlanEvent p;
   while (plan_q_.try_pop(p)) {
+    if (p.kind == PlanEvent::kTrajectory) {
+      if (opt_.plan_log) {
+        std::string reason = p.reason;  // CSV: commas in a reason become semicolons
+        std::replace(reason.begin(), reason.end(), ',', ';');
+        std::snprintf(line, sizeof line, "%.2f,%s,%d,%.2f,%.2f,%.2f", p.t_s, reason.c_str(),
+                      p.cluster, double(p.x_m), double(p.y_m), double(p.z_m));
+        opt_.plan_log(line);
+      }
+      continue;
+    }
     switch (p.kind) {
       case PlanEvent::kFloor:
         std::snprintf(line, sizeof line, "t=%.2f s: on floor %d (robot at %.2f, %.2f, %.2f m)",
@@ -662,6 +680,8 @@ void Autonomy::telemetry_step() {
         std::snprintf(line, sizeof line,
                       "t=%.2f s: stranded: %s, but the robot is cut off from the frontiers left",
                       p.t_s, p.reason);
+        break;
+      case PlanEvent::kTrajectory:
         break;
     }
     log(line);

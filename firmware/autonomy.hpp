@@ -109,14 +109,23 @@ const char* to_string(ExplorationState s);
 // "  -> cluster 12 at 3.0, 4.5, 0.0" (or "" without a target): for progress lines.
 std::string describe_target(const ExplorationStatus& s);
 
-// Plan task -> telemetry (non-RT log): floor changes, prior built, failures, completion.
+// Plan task -> telemetry (non-RT log): floor changes, prior built, failures, completion; and
+// every new trajectory (kTrajectory: to AutonomyOptions::plan_log only).
 struct PlanEvent {
-  enum Kind : uint8_t { kFloor = 0, kPrior, kFailed, kComplete, kStranded } kind = kFloor;
+  enum Kind : uint8_t {
+    kFloor = 0,
+    kPrior,
+    kFailed,
+    kComplete,
+    kStranded,
+    kTrajectory
+  } kind = kFloor;
   double t_s = 0;
   int32_t floor = -1, reference_floor = -1;
   double dz_m = 0;
   const char* reason = "";          // string literal
-  float x_m = 0, y_m = 0, z_m = 0;  // kFloor: where the robot stood
+  float x_m = 0, y_m = 0, z_m = 0;  // kFloor: where the robot stood; kTrajectory: its target
+  int32_t cluster = -1;             // kTrajectory: the target's cluster (-1: a goal, an escape)
 };
 
 struct StopEvent {
@@ -147,7 +156,11 @@ struct AutonomyOptions {
   int ingest_fd = -1;
   double lockstep_event_hz = 100;               // how often the ingest row is polled in lockstep
   std::function<void(const std::string&)> log;  // non-RT log sink (telemetry task); default stderr
+  // One CSV row per new trajectory (kPlanLogHeader's columns; telemetry task; none if unset):
+  // why the planner changed course, and toward what (run record plan.csv).
+  std::function<void(const std::string&)> plan_log;
 };
+inline constexpr const char* kPlanLogHeader = "t_s,reason,cluster,target_x_m,target_y_m,target_z_m";
 
 class Autonomy {
  public:

@@ -2,6 +2,8 @@
 // the two-floor `house` scene in lockstep: with config/default.yaml the robot finishes the ground
 // floor, climbs the flight blind onto the landing (plan.climb_blind) and explores the upper floor.
 // The paper-literal pipeline (the session 9-11 switches off) is checked on the ground floor.
+#include <cstdio>
+
 #include <gtest/gtest.h>
 
 #include "tests/integration/expectations.hpp"
@@ -148,6 +150,44 @@ TEST(ExploreHouse, MetricsNameTheMethodAndHowTheRunEnded) {
   EXPECT_NE(j.find("\"end_reason\": \"exploration complete at 1.0 s: \\\"quoted\\\"\""),
             std::string::npos)
       << j;
+}
+
+// The run record says why the robot went where it went: plan.csv holds one row per new trajectory
+// (the planner's reason, the target), and diagnostics.md explains each C_exp frontier left by the
+// unknown that opens its probes (20 s into the house: frontiers everywhere).
+TEST(ExploreHouse, TheRunRecordLogsThePlanAndExplainsTheFrontiersLeft) {
+  SimRunOptions o = house_options(20);
+  o.out_dir = testing::TempDir() + "/house_record";
+  const SimRunResult a = run_exploration(o);
+  std::ifstream plan(o.out_dir + "/plan.csv");
+  ASSERT_TRUE(plan.good()) << "no plan.csv in " << o.out_dir;
+  std::string line;
+  std::getline(plan, line);
+  EXPECT_EQ(line, "t_s,reason,cluster,target_x_m,target_y_m,target_z_m");
+  int rows = 0;
+  double last_t = -1;
+  while (std::getline(plan, line)) {
+    double t = -1, x = 0, y = 0, z = 0;
+    int cluster = -2;
+    char reason[128] = {};
+    ASSERT_EQ(
+        std::sscanf(line.c_str(), "%lf,%127[^,],%d,%lf,%lf,%lf", &t, reason, &cluster, &x, &y, &z),
+        6)
+        << line;
+    EXPECT_GE(t, last_t);
+    EXPECT_LE(t, 20.0);
+    EXPECT_GT(std::string(reason).size(), 3u) << line;
+    EXPECT_GE(cluster, -1);
+    last_t = t;
+    ++rows;
+  }
+  EXPECT_GE(rows, 2);
+  std::ifstream d(o.out_dir + "/diagnostics.md");
+  std::stringstream ds;
+  ds << d.rdbuf();
+  const std::string diag = ds.str();
+  ASSERT_NE(diag.find("Open C_exp probes"), std::string::npos) << diag.substr(0, 2000);
+  EXPECT_NE(diag.find(" deg: unknown"), std::string::npos) << diag.substr(0, 2000);
 }
 
 }  // namespace

@@ -99,6 +99,7 @@ struct RecordInputs {
   const Autonomy* autonomy;
   const std::vector<Eigen::Vector3d>* path;
   const std::string* tracking_csv;  // tracking.csv's rows (10 Hz)
+  const std::string* plan_csv;      // plan.csv's rows (one per new trajectory)
   const SimRunResult* result;
   std::string error;  // set when the run failed with an exception
 };
@@ -185,6 +186,11 @@ void write_record(const RecordInputs& in, std::vector<std::string>& written) {
          "left_m\n"
       << *in.tracking_csv;
     if (f) written.push_back("tracking.csv");
+  }
+  {
+    std::ofstream f(dir + "/plan.csv");
+    f << firmware::kPlanLogHeader << "\n" << *in.plan_csv;
+    if (f) written.push_back("plan.csv");
   }
   // Pictures: one top-down view per ground-truth floor, one side view.
   std::vector<std::string> pictures;
@@ -365,6 +371,8 @@ SimRunResult run_exploration(const SimRunOptions& opt) {
     res.log.push_back(line);
     progress("  firmware: " + line);
   };
+  std::string plan_csv;  // every new trajectory: why and toward what (plan.csv)
+  ao.plan_log = [&](const std::string& row) { plan_csv.append(row).push_back('\n'); };
   Autonomy autonomy(platform, clock, ao);
 
   std::vector<Eigen::Vector3d> path;
@@ -523,7 +531,7 @@ SimRunResult run_exploration(const SimRunOptions& opt) {
               m.collisions == 0 && m.falls == 0;
 
   if (!opt.out_dir.empty()) {
-    RecordInputs ri{&opt, &scene, &gt, &autonomy, &path, &tracking_csv, &res, error};
+    RecordInputs ri{&opt, &scene, &gt, &autonomy, &path, &tracking_csv, &plan_csv, &res, error};
     std::vector<std::string> written;
     write_record(ri, written);
     res.report_path = opt.out_dir + "/report.md";
