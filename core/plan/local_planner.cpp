@@ -166,9 +166,18 @@ bool LocalPlanner::retry_from_elsewhere(const LocalPlanInput& in, LocalPlanResul
   // yet: a retry then went for the failures left below and walked back down the flight
   // (test_stair seed 1, session 22).
   if (climb_done_s_ >= 0 && in.t_s - climb_done_s_ < opt_.climb_settle_s) return false;
+  const double flight_rise_m = 2.0 * robot_.step_height_m;
+  // Up a flight, or at the foot of one (flight_foot finds it from the frontier).
+  auto on_flight = [&](const SetAsideEntry& e) {
+    if (!plan_opt_.retry_flight_frontiers || e.reason != SetAsideReason::kStillFrontierAtTarget)
+      return false;
+    if (double(e.p_m.z()) - in.robot_foot_m.z() >= flight_rise_m) return true;
+    const std::vector<Eigen::Vector3d> at{e.p_m.cast<double>()};
+    return flight_foot(*in.view, at, in.robot_foot_m.z()).has_value();
+  };
   auto eligible = [&](const SetAsideEntry& e) {
     return (e.reason == SetAsideReason::kAstarFailed ||
-            e.reason == SetAsideReason::kTrajectoryFailed) &&
+            e.reason == SetAsideReason::kTrajectoryFailed || on_flight(e)) &&
            e.retries < plan_opt_.path_retries && !e.retry_pending;
   };
   if (std::none_of(set_aside_.begin(), set_aside_.end(), eligible) || !free_start(in)) return false;
@@ -211,8 +220,15 @@ bool LocalPlanner::retry_from_elsewhere(const LocalPlanInput& in, LocalPlanResul
     const Eigen::Vector2d dir = (p - in.robot_foot_m).head<2>();
     SetAsideReason why;
     if (!try_target(in, Viewpoint{p, std::atan2(dir.y(), dir.x()), n}, out, &why)) continue;
-    for (SetAsideEntry& e : set_aside_)
-      if (eligible(e)) ++e.retries, e.retry_pending = true;
+    for (SetAsideEntry& e : set_aside_) {
+      if (!eligible(e)) continue;
+      ++e.retries, e.retry_pending = true;
+      // Its flight's foot becomes a target again (to_flight_foot tries each foot once).
+      if (on_flight(e))
+        std::erase_if(flight_feet_tried_, [&](const Eigen::Vector3f& q) {
+          return (q - e.p_m).head<2>().norm() < 3.0f;
+        });
+    }
     retrying_ = true;
     climbing_ = false;
     adopt_move(in, out, "retry: to a new vantage point for frontiers no path reached",
@@ -776,7 +792,7 @@ void keep_over_nosings(std::vector<Eigen::Vector3d>& pts, const std::vector<Eige
 // allowed only where rays crossed the body's space (no wall unseen) and nothing observed lies
 // more than a step below the last support (no known drop).
 bool LocalPlanner::climb_on(const LocalPlanInput& in, LocalPlanResult& out, bool on_flight_only,
-                            const FlightFoot* given) {
+                            const FlightFoot* given, bool stored_axis) {
   const map::MapView& view = *in.view;
   const Eigen::Vector3d foot = in.robot_foot_m;
   // The flight the robot faces; at a frontier at a flight's foot (not yet on it) also one beside
@@ -789,7 +805,7 @@ bool LocalPlanner::climb_on(const LocalPlanInput& in, LocalPlanResult& out, bool
   const ClimbedFlight* end_of =
       plan_opt_.flight_foot && on_flight_only ? partial_climb_end(foot) : nullptr;
   if (given) axis = given->axis;
-  if (end_of) axis = end_of->axis;
+  if (end_of && stored_axis) axis = end_of->axis;
   for (double ahead = 0.0;
        ahead <= (on_flight_only ? 0.0 : plan_opt_.climb_axis_ahead_m) + 1e-9 && !axis; ahead += 0.3)
     for (int k = 0; k < (on_flight_only ? 1 : 4) && !axis; ++k) {
@@ -1189,8 +1205,14 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   };
   // The blind climb (PlanOptions::climb_blind), at most max_climbs times without a new target.
   auto try_climb = [&](bool on_flight_only, const FlightFoot* given = nullptr) {
-    if (!plan_opt_.climb_blind || climbs_ >= opt_.max_climbs ||
-        !climb_on(in, out, on_flight_only, given))
+    if (!plan_opt_.climb_blind || climbs_ >= opt_.max_climbs) return false;
+    // PlanOptions::climb_axis_anew: at a partial climb's end, also up the axis the robot faces
+    // now (a climb from a flight's foot along an axis 0.2 m off the flight's middle stopped on
+    // it, and its walk on along that axis hit the flight's side wall: house seed 9).
+    if (!climb_on(in, out, on_flight_only, given) &&
+        !(plan_opt_.climb_axis_anew && on_flight_only && plan_opt_.flight_foot &&
+          partial_climb_end(in.robot_foot_m) &&
+          climb_on(in, out, on_flight_only, given, /*stored_axis=*/false)))
       return false;
     ++climbs_;
     return true;

@@ -291,9 +291,10 @@ class LocalPlanner {
   // Facing up a flight: straight up the flight's axis to the last support seen and
   // landing_step_m beyond (see local_planner.cpp). on_flight_only: only if the robot stands on
   // the flight already (a lower tread behind it).
-  // given: the flight from to_flight_foot (the robot stands at its foot).
+  // given: the flight from to_flight_foot (the robot stands at its foot). stored_axis: at a
+  // partial climb's end, that climb's axis (else the axis the robot faces, found anew).
   bool climb_on(const LocalPlanInput& in, LocalPlanResult& out, bool on_flight_only,
-                const FlightFoot* given = nullptr);
+                const FlightFoot* given = nullptr, bool stored_axis = true);
   // PlanOptions::flight_foot: cluster c, about to be set aside, has a flight's first riser near:
   // a new target at the flight's foot (flight_foot()), once per foot; false if none.
   // The floor has no other target, or its graph stopped growing (stale): to the foot of a flight

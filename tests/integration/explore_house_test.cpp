@@ -152,6 +152,34 @@ TEST(ExploreHouse, MetricsNameTheMethodAndHowTheRunEnded) {
       << j;
 }
 
+// With the phantom frontiers on walls' faces closed (graph.close_probes_at_wall_faces) a floor
+// runs out of targets right after one failed climb: house seed 9's climb from the flight's foot
+// went along an axis 0.2 m off the flight's middle, stopped on the flight, and the walk on along
+// that axis met the side wall; the run ended "complete" with the upper floor at 1.4 % (measured,
+// session 33). plan.climb_axis_anew tries the walk on up the axis the robot faces, found anew,
+// and plan.retry_flight_frontiers retries a flight's frontiers before "complete" (house seed 5:
+// a climb refused at the foot, the frontier set aside, "complete" at 61 s).
+TEST(ExploreHouse, WithWallFacesClosedAFailedClimbIsTriedAgain) {
+  const std::pair<std::string, std::string> faces = {"close_probes_at_wall_faces: false",
+                                                     "close_probes_at_wall_faces: true"};
+  SimRunOptions o = quiet_run("house", 9, 400);
+  o.config = edited_default_config("house_faces.yaml", {faces});
+  ASSERT_FALSE(o.config.empty());
+  const SimRunResult before = run_exploration(o);
+  EXPECT_TRUE(before.completed) << before.end_reason;
+  ASSERT_EQ(before.metrics.per_floor.size(), 2u);
+  EXPECT_LT(before.metrics.per_floor[1].traversable_coverage, 0.1)
+      << "the failure this test guards against is gone: update the comment and this check";
+  o.config = edited_default_config(
+      "house_faces_retry.yaml", {faces,
+                                 {"retry_flight_frontiers: false", "retry_flight_frontiers: true"},
+                                 {"climb_axis_anew: false", "climb_axis_anew: true"}});
+  ASSERT_FALSE(o.config.empty());
+  expect_every_floor_explored_safely(run_exploration(o), 2);
+  o.seed = 5;
+  expect_every_floor_explored_safely(run_exploration(o), 2);
+}
+
 // The run record says why the robot went where it went: plan.csv holds one row per new trajectory
 // (the planner's reason, the target), and diagnostics.md explains each C_exp frontier left by the
 // unknown that opens its probes (20 s into the house: frontiers everywhere).
