@@ -24,7 +24,8 @@ struct GraphOptions {
   // probe entering unknown space through a voxel-sized gap in a surface (a wall seen at grazing
   // angles) is closed.
   bool close_probes_at_holes = false;
-  // Beyond the paper, off (graph.close_probes_at_wall_faces, session 25): a C_exp probe that meets
+  // Beyond the paper, on in config/default.yaml since session 33 (graph.close_probes_at_wall_faces,
+  // session 25): a C_exp probe that meets
   // a wall's face where a voxel of it has free space over it takes no "step" there (the wall
   // rises on behind it, SupportQuery::wall_face); off, such a voxel seen edge-on is a tread.
   bool close_probes_at_wall_faces = false;

@@ -160,15 +160,16 @@ struct PlanOptions {
   // Beyond the paper (session 32): the drive toward a zone centre (ExplorationPlanner::drive_to)
   // is kept while its reference has more than a second to go, not planned anew each cycle.
   bool keep_zone_drive = false;
-  // Beyond the paper (session 33): before "complete", frontiers on a flight (two steps or more
-  // above the robot's floor, or where flight_foot finds a flight's foot) set aside as still
-  // frontiers at their target are retried like path failures (path_retries): a walk to a new
-  // vantage point, then their flight's foot again. With graph.close_probes_at_wall_faces the floor
-  // runs out of phantom frontiers, and a climb that failed once from the foot ended the run below
-  // its upper floor (house seed 5).
+  // Beyond the paper, on in config/default.yaml (session 33): before "complete", frontiers on a
+  // flight (two steps or more above the robot's floor, or where flight_foot finds a flight's foot)
+  // set aside as still frontiers at their target are retried like path failures (path_retries): a
+  // walk to a new vantage point, then their flight's foot again. With
+  // graph.close_probes_at_wall_faces the floor runs out of phantom frontiers, and a climb that
+  // failed once from the foot ended the run below its upper floor (house seed 5).
   bool retry_flight_frontiers = false;
-  // Beyond the paper (session 33): a climb going on from a partial climb's end that fails along
-  // that climb's axis is tried up the axis the robot faces, found anew (LocalPlanner::climb_on).
+  // Beyond the paper, on in config/default.yaml (session 33): a climb going on from a partial
+  // climb's end that fails along that climb's axis is tried up the axis the robot faces, found anew
+  // (LocalPlanner::climb_on).
   bool climb_axis_anew = false;
   bool incremental_maintenance = true;
 };

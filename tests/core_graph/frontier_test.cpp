@@ -129,7 +129,9 @@ TEST(TopologicalFrontiers, ExplainNamesTheUnknownThatOpensEachProbe) {
     ASSERT_EQ(probes.size(), size_t(o.probes));
     int open = 0;
     for (const ProbeExplanation& p : probes) {
-      if (p.covered) EXPECT_EQ(p.state, ProbeState::kOther);
+      if (p.covered) {
+        EXPECT_EQ(p.state, ProbeState::kOther);
+      }
       if (p.state != ProbeState::kOpen) {
         EXPECT_EQ(p.why.by, SupportQuery::OpenBy::kNone);
         continue;

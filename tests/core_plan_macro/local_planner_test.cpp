@@ -1635,7 +1635,9 @@ size_t scheduled(int tsp_max_clusters, size_t* n_clusters) {
   LocalPlanner lp(RobotModel{}, po, 0.1);
   const LocalPlanResult r = lp.plan(input(h, view, Eigen::Vector3f(0, 1.5f, 0), 0.0));
   EXPECT_EQ(r.status, LocalPlanStatus::kNewTrajectory) << r.replan_reason;
-  if (!r.cluster_order.empty()) EXPECT_EQ(r.target_cluster, r.cluster_order[0]);
+  if (!r.cluster_order.empty()) {
+    EXPECT_EQ(r.target_cluster, r.cluster_order[0]);
+  }
   return r.cluster_order.size();
 }
 }  // namespace
