@@ -650,16 +650,6 @@ void Autonomy::telemetry_step() {
   }
   PlanEvent p;
   while (plan_q_.try_pop(p)) {
-    if (p.kind == PlanEvent::kTrajectory) {
-      if (opt_.plan_log) {
-        std::string reason = p.reason;  // CSV: commas in a reason become semicolons
-        std::replace(reason.begin(), reason.end(), ',', ';');
-        std::snprintf(line, sizeof line, "%.2f,%s,%d,%.2f,%.2f,%.2f", p.t_s, reason.c_str(),
-                      p.cluster, double(p.x_m), double(p.y_m), double(p.z_m));
-        opt_.plan_log(line);
-      }
-      continue;
-    }
     switch (p.kind) {
       case PlanEvent::kFloor:
         std::snprintf(line, sizeof line, "t=%.2f s: on floor %d (robot at %.2f, %.2f, %.2f m)",
@@ -681,8 +671,15 @@ void Autonomy::telemetry_step() {
                       "t=%.2f s: stranded: %s, but the robot is cut off from the frontiers left",
                       p.t_s, p.reason);
         break;
-      case PlanEvent::kTrajectory:
-        break;
+      case PlanEvent::kTrajectory: {  // plan.csv only, not the log
+        if (!opt_.plan_log) continue;
+        std::string reason = p.reason;  // CSV: commas in a reason become semicolons
+        std::replace(reason.begin(), reason.end(), ',', ';');
+        std::snprintf(line, sizeof line, "%.2f,%s,%d,%.2f,%.2f,%.2f", p.t_s, reason.c_str(),
+                      p.cluster, double(p.x_m), double(p.y_m), double(p.z_m));
+        opt_.plan_log(line);
+        continue;
+      }
     }
     log(line);
   }

@@ -25,9 +25,9 @@ struct GraphOptions {
   // angles) is closed.
   bool close_probes_at_holes = false;
   // Beyond the paper, on in config/default.yaml since session 33 (graph.close_probes_at_wall_faces,
-  // session 25): a C_exp probe that meets
-  // a wall's face where a voxel of it has free space over it takes no "step" there (the wall
-  // rises on behind it, SupportQuery::wall_face); off, such a voxel seen edge-on is a tread.
+  // session 25): a C_exp probe that meets a wall's face where a voxel of it has free space over it
+  // takes no "step" there (the wall rises on behind it, SupportQuery::wall_face); off, such a
+  // voxel seen edge-on is a tread.
   bool close_probes_at_wall_faces = false;
   // Beyond the paper, off (graph.passage_frontiers, sessions 26, 28): C_exp also holds for an
   // open probe whose two neighbours are both blocked by obstacles (passage_probes): a corridor or

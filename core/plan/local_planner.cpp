@@ -166,21 +166,24 @@ bool LocalPlanner::retry_from_elsewhere(const LocalPlanInput& in, LocalPlanResul
   // yet: a retry then went for the failures left below and walked back down the flight
   // (test_stair seed 1, session 22).
   if (climb_done_s_ >= 0 && in.t_s - climb_done_s_ < opt_.climb_settle_s) return false;
+  // Which set-asides are retried, decided once (flight_foot searches the map): path failures, and
+  // with retry_flight_frontiers still frontiers up a flight or at the foot of one.
+  enum Pick : uint8_t { kNo = 0, kPath, kFlight };
   const double flight_rise_m = 2.0 * robot_.step_height_m;
-  // Up a flight, or at the foot of one (flight_foot finds it from the frontier).
-  auto on_flight = [&](const SetAsideEntry& e) {
-    if (!plan_opt_.retry_flight_frontiers || e.reason != SetAsideReason::kStillFrontierAtTarget)
-      return false;
-    if (double(e.p_m.z()) - in.robot_foot_m.z() >= flight_rise_m) return true;
-    const std::vector<Eigen::Vector3d> at{e.p_m.cast<double>()};
-    return flight_foot(*in.view, at, in.robot_foot_m.z()).has_value();
-  };
-  auto eligible = [&](const SetAsideEntry& e) {
-    return (e.reason == SetAsideReason::kAstarFailed ||
-            e.reason == SetAsideReason::kTrajectoryFailed || on_flight(e)) &&
-           e.retries < plan_opt_.path_retries && !e.retry_pending;
-  };
-  if (std::none_of(set_aside_.begin(), set_aside_.end(), eligible) || !free_start(in)) return false;
+  std::vector<uint8_t> pick(set_aside_.size(), kNo);
+  for (size_t i = 0; i < set_aside_.size(); ++i) {
+    const SetAsideEntry& e = set_aside_[i];
+    if (e.retries >= plan_opt_.path_retries || e.retry_pending) continue;
+    if (e.reason == SetAsideReason::kAstarFailed || e.reason == SetAsideReason::kTrajectoryFailed)
+      pick[i] = kPath;
+    else if (plan_opt_.retry_flight_frontiers &&
+             e.reason == SetAsideReason::kStillFrontierAtTarget &&
+             (double(e.p_m.z()) - in.robot_foot_m.z() >= flight_rise_m ||
+              flight_foot(*in.view, {e.p_m.cast<double>()}, in.robot_foot_m.z())))
+      pick[i] = kFlight;
+  }
+  if (std::none_of(pick.begin(), pick.end(), [](uint8_t k) { return k != kNo; }) || !free_start(in))
+    return false;
   const graph::ReachableGraph& g = *in.graph;
   const double r_min = opt_.retry_move_m, d_max = 3.0 * opt_.retry_move_m;
   auto far_enough = [&](graph::NodeId n) {
@@ -191,11 +194,13 @@ bool LocalPlanner::retry_from_elsewhere(const LocalPlanInput& in, LocalPlanResul
   // from the corridor beside it), which a start closer by takes with room to spare.
   std::vector<graph::NodeId> cands;
   const SetAsideEntry* nearest = nullptr;
-  for (const SetAsideEntry& e : set_aside_)
-    if (eligible(e) &&
+  for (size_t i = 0; i < set_aside_.size(); ++i) {
+    const SetAsideEntry& e = set_aside_[i];
+    if (pick[i] != kNo &&
         (!nearest || (e.p_m - in.robot_foot_m.cast<float>()).squaredNorm() <
                          (nearest->p_m - in.robot_foot_m.cast<float>()).squaredNorm()))
       nearest = &e;
+  }
   const graph::NodeId goal = g.nearest(nearest->p_m, 0.5f, 0.5f);
   if (goal != graph::kNoId && goal < sg_.num_nodes()) {
     const PathResult path = pair_search_.astar(sg_, robot_node_, goal);
@@ -220,11 +225,12 @@ bool LocalPlanner::retry_from_elsewhere(const LocalPlanInput& in, LocalPlanResul
     const Eigen::Vector2d dir = (p - in.robot_foot_m).head<2>();
     SetAsideReason why;
     if (!try_target(in, Viewpoint{p, std::atan2(dir.y(), dir.x()), n}, out, &why)) continue;
-    for (SetAsideEntry& e : set_aside_) {
-      if (!eligible(e)) continue;
+    for (size_t i = 0; i < set_aside_.size(); ++i) {
+      if (pick[i] == kNo) continue;
+      SetAsideEntry& e = set_aside_[i];
       ++e.retries, e.retry_pending = true;
       // Its flight's foot becomes a target again (to_flight_foot tries each foot once).
-      if (on_flight(e))
+      if (pick[i] == kFlight)
         std::erase_if(flight_feet_tried_, [&](const Eigen::Vector3f& q) {
           return (q - e.p_m).head<2>().norm() < 3.0f;
         });
