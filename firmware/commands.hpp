@@ -7,6 +7,9 @@
 namespace storey::firmware {
 
 inline constexpr const char* kVersion = "0.1.0";
+// The commit the executable was built from (`git describe --always --dirty`; "unknown" outside a
+// git checkout): run records name it, so results from different code are never mixed unseen.
+const char* build_commit();
 
 struct Command {
   const char* name;

@@ -33,7 +33,8 @@ int main(int argc, char** argv) {
     return 0;
   }
   if (verb == "--version") {
-    std::printf("storey %s\n", storey::firmware::kVersion);
+    std::printf("storey %s (commit %s)\n", storey::firmware::kVersion,
+                storey::firmware::build_commit());
     return 0;
   }
   for (const Command& c : storey::firmware::commands()) {

@@ -35,6 +35,14 @@ Occupancy SupportQuery::occupancy(const VoxelKey& k) {
   return c->log_odds > occ_q_ ? Occupancy::kOccupied : Occupancy::kFree;
 }
 
+// MapOptions::floor_seen_from_above: S_untrav as not a top (nothing occupied above it here: seen
+// only from below), or too few points for tau(v) and every ray that hit it rose.
+bool SupportQuery::underside(const Cell& c, const map::VoxelStats* st) const {
+  if (!st || !view_.options().floor_seen_from_above) return false;
+  if (c.state == TravState::kUnobserved) return st->min_rise >= 2;
+  return c.state == TravState::kUntraversable && (st->reasons & map::VoxelStats::kReasonNotTop);
+}
+
 std::optional<Support> SupportQuery::surface_near(float x, float y, float z, float window) {
   const int32_t cx = int32_t(std::floor(x * inv_vs_)), cy = int32_t(std::floor(y * inv_vs_));
   const int32_t z_lo = zkey(z - window) - 1, z_hi = zkey(z + window) + 1;
@@ -53,8 +61,12 @@ std::optional<Support> SupportQuery::surface_near(float x, float y, float z, flo
       const float d = std::abs(h - z);
       if (d <= window && d < best_d) {
         best_d = d;
-        best = Support{Eigen::Vector3f(x, y, h), k, c->state, bool(c->flags & Cell::kReachable),
-                       st ? st->cost : 0.0f};
+        best = Support{Eigen::Vector3f(x, y, h),
+                       k,
+                       c->state,
+                       bool(c->flags & Cell::kReachable),
+                       st ? st->cost : 0.0f,
+                       underside(*c, st)};
       }
     }
     above = occ;

@@ -23,6 +23,9 @@ struct Support {
   map::TravState state = map::TravState::kNone;   // tau(v), Eq. 3
   bool reachable = false;                         // v in C_reach
   float cost = 0;                                 // c(v), Eq. 2
+  // v was seen only from below (MapOptions::floor_seen_from_above): a slab's underside,
+  // whatever lies above it not yet observed.
+  bool underside = false;
 };
 
 // Why an element is invalid (diagnostics, counted by the graph).
@@ -121,6 +124,7 @@ class SupportQuery {
   float step() const { return step_; }
 
  private:
+  bool underside(const map::Cell& c, const map::VoxelStats* st) const;
   // One straight leg of a C_exp probe: counts free voxels and the current unknown run (carried
   // over between legs); stops at the first occupied voxel (hit) or at unknown space met before
   // need_free free voxels (closed).

@@ -28,7 +28,10 @@ struct MapOptions {
   // slab's inside never observed, read as a floor over the whole building (teaching_building seed
   // 1 with a 0.3 rad yaw gate: 1,473 graph nodes on the 3.0 m underside of the 3.2 m floor, every
   // cluster there unreachable, and "complete" on the upper floor at 2.5 %). A step edge (a riser's
-  // top seen from below, the tread behind it inferred) is exempt.
+  // top seen from below, the tread behind it inferred) is exempt. With it, graph::SupportQuery
+  // marks such a surface an underside and Eq. 5 counts it missing (session 34: test_ramp seed 4's
+  // upper corridors, seen only from below, then hold C_sur frontiers; the teaching building's
+  // upper floor was then never reached).
   bool floor_seen_from_above = false;
   // --- occupancy (ray casting) ---
   double voxel_size_m = 0.1;    // map resolution

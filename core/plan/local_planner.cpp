@@ -97,14 +97,36 @@ void LocalPlanner::set_aside_cluster(const LocalPlanInput& in, const graph::Fron
                                      SetAsideReason reason, const Eigen::Vector3f& hit_m) {
   const graph::ReachableGraph& g = *in.graph;
   const float r = float(opt_.track_radius_m);
+  // The largest count of a place near p (a frontier set aside here before keeps its counts).
+  auto count_near = [r](const std::vector<Retried>& places, const Eigen::Vector3f& p) {
+    int k = 0;
+    for (const Retried& q : places)
+      if ((q.p_m - p).head<2>().norm() <= r && std::abs(q.p_m.z() - p.z()) < 0.5f)
+        k = std::max(k, q.retries);
+    return k;
+  };
+  constexpr float kSamePlaceM = 0.1f;  // a node re-sampled this close is the same place
+  const bool unresolved =
+      plan_opt_.set_aside_backoff &&
+      (reason == SetAsideReason::kStillFrontierAtTarget || reason == SetAsideReason::kOverdue);
+  unresolved_new_.clear();
   for (graph::NodeId n : c.nodes) {
     const Eigen::Vector3f p = g.node(n).p_m;
-    int retries = 0;  // a frontier retried here before keeps its count
-    for (const Retried& q : retried_)
-      if ((q.p_m - p).head<2>().norm() <= r && std::abs(q.p_m.z() - p.z()) < 0.5f)
-        retries = std::max(retries, q.retries);
+    const int k = unresolved ? count_near(unresolved_, p) : 0;  // set aside unresolved before
     set_aside_.push_back({p, in.t_s, c.id, reason, in.robot_foot_m.cast<float>(),
-                          frontier_signature(g.node(n)), hit_m, retries});
+                          frontier_signature(g.node(n)), hit_m, count_near(retried_, p), false,
+                          opt_.set_aside_expiry_s * double(1 << std::min(4, k))});
+    if (unresolved) unresolved_new_.push_back({p, k + 1});
+  }
+  // Recorded after the lookups (a cluster's nodes lie close together); one entry per place.
+  for (const Retried& q : unresolved_new_) {
+    auto same = std::find_if(unresolved_.begin(), unresolved_.end(), [&](const Retried& o) {
+      return (o.p_m - q.p_m).squaredNorm() < kSamePlaceM * kSamePlaceM;
+    });
+    if (same != unresolved_.end())
+      same->retries = std::max(same->retries, q.retries);
+    else
+      unresolved_.push_back(q);
   }
 }
 
@@ -113,8 +135,9 @@ void LocalPlanner::set_aside_cluster(const LocalPlanInput& in, const graph::Fron
 //  1) the map near it changed: no live node within set_aside_radius_m any more, or the nearest
 //     one moved, is no frontier, or has other frontier flags than then (TopologicalFrontiers
 //     recomputes them where the map changed);
-//  2) set_aside_expiry_s passed and the robot is more than set_aside_expiry_move_m from where it
-//     stood then: another vantage point may resolve it.
+//  2) its expiry_s (set_aside_expiry_s, with set_aside_backoff longer where frontiers were set
+//     aside unresolved before) passed and the robot is more than set_aside_expiry_move_m from
+//     where it stood then: another vantage point may resolve it.
 // Only inputs decide (t_s is the input's time base, no clock), so replays repeat it.
 int LocalPlanner::expire_set_aside(const LocalPlanInput& in) {
   constexpr float kMovedM = 0.05f;  // a node this far from its recorded position was re-sampled
@@ -140,8 +163,8 @@ int LocalPlanner::expire_set_aside(const LocalPlanInput& in) {
       expire =
           !gn.frontier() || frontier_signature(gn) != e.frontier_sig || best_d > kMovedM * kMovedM;
     }
-    expire = expire || (in.t_s - e.t_s >= opt_.set_aside_expiry_s &&
-                        (robot - e.robot_m).head<2>().squaredNorm() > move2);
+    expire = expire ||
+             (in.t_s - e.t_s >= e.expiry_s && (robot - e.robot_m).head<2>().squaredNorm() > move2);
     if (!expire)
       set_aside_[kept++] = e;
     else if (e.retries > 0)

@@ -119,6 +119,9 @@ struct SetAsideEntry {
   Eigen::Vector3f hit_m = kNoHitM;
   int retries = 0;             // path-failure retries from a new vantage point so far (here)
   bool retry_pending = false;  // released when the retry move ends
+  // Rule 2 of expire_set_aside: the time after which a move away releases it (set_aside_expiry_s,
+  // doubled per earlier set-aside here with PlanOptions::set_aside_backoff).
+  double expiry_s = 30.0;
 };
 // C_sur, C_exp, boundary and |Theta_open| of a node packed: what TopologicalFrontiers
 // recomputes when the map near the node changes.
@@ -365,6 +368,9 @@ class LocalPlanner {
     int retries;
   };
   std::vector<Retried> retried_;
+  // PlanOptions::set_aside_backoff: places where frontier nodes were set aside unresolved (still
+  // frontiers at their target, or overdue), with how often (Retried::retries counts them here).
+  std::vector<Retried> unresolved_, unresolved_new_;
   bool retrying_ = false;
   std::vector<std::pair<int32_t, int>> failures_;
   Eigen::Vector3f last_hit_m_ = kNoHitM;  // try_target: where the last B-spline collided

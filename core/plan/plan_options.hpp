@@ -171,6 +171,13 @@ struct PlanOptions {
   // climb's end that fails along that climb's axis is tried up the axis the robot faces, found anew
   // (LocalPlanner::climb_on).
   bool climb_axis_anew = false;
+  // Beyond the paper, off in config/default.yaml (session 34): a frontier set aside unresolved
+  // (still a frontier with the robot at its viewpoint, or overdue) where one was set aside before
+  // waits twice as long (up to 16x) before a move away releases it. A hole by a wall end that the
+  // robot's blind ring covers from every viewpoint drew the robot back every 30 s for the maze's
+  // last 350 s (seed 1, ground floor 75.9 %; 94.1 % with it). Off: office seed 2's path with it
+  // went back onto the flight from its landing and wedged the body (docs/RESULTS.md).
+  bool set_aside_backoff = false;
   bool incremental_maintenance = true;
 };
 

@@ -548,6 +548,57 @@ TEST(TopologicalFrontiers, ASlabSeenFromBelowIsNoSurfaceForTheFloorAbove) {
   }
 }
 
+// With MapOptions::floor_seen_from_above a slab seen only from below is S_untrav, and
+// SupportQuery says it is an underside: Eq. 5 counts it as missing even where rays grazing the
+// floor above carved the voxels over it free (test_ramp seed 4's corridors). Its top, once seen
+// from above, is the surface and no underside.
+TEST(SupportQuery, ASlabSeenOnlyFromBelowIsAnUnderside) {
+  World w;
+  w.add({-6, -6, -0.3f}, {6, 6, 0.0f});  // ground floor
+  w.add({-6, -6, 2.8f}, {6, 6, 3.0f});   // the upper floor's slab
+  World upper;
+  upper.add({-6, -6, 2.8f}, {6, 6, 3.0f});
+  for (const bool on : {false, true}) {
+    SCOPED_TRACE(on ? "map.floor_seen_from_above on" : "off");
+    storey::core::map::MapOptions mo;
+    mo.spill_is_surface = mo.miss_needs_crossing = true;  // as in config/default.yaml
+    mo.floor_seen_from_above = on;
+    storey::core::map::TraversabilityMap m(mo);
+    uint32_t seed = 1;
+    for (const float x : {-2.0f, 0.0f, 2.0f}) {
+      const Vector3f o(x, 0.3f, 0.55f);
+      m.insert_scan(o, storey::test::graph::scan(w, o, 60000, seed++, 12.0f));
+    }
+    m.update_traversability();
+    // Samples over the middle, within a step of the upper floor (3.0 m).
+    auto count = [&](int* found, int* under) {
+      SupportQuery q(m.view(), GraphOptions{});
+      *found = *under = 0;
+      for (float x = -1.95f; x < 2.0f; x += 0.3f)
+        for (float y = -1.95f; y < 2.0f; y += 0.3f)
+          if (const auto s = q.surface_near(x, y, 3.0f, 0.2f)) {
+            ++*found;
+            *under += s->underside;
+          }
+    };
+    int found = 0, under = 0;
+    count(&found, &under);
+    EXPECT_GE(found, 150);  // of 196
+    if (on)
+      EXPECT_GE(under, found * 9 / 10);
+    else
+      EXPECT_EQ(under, 0);
+    for (const float x : {-2.0f, 0.0f, 2.0f}) {
+      const Vector3f o(x, 0.3f, 3.55f);
+      m.insert_scan(o, storey::test::graph::scan(upper, o, 60000, seed++, 12.0f));
+    }
+    m.update_traversability();
+    count(&found, &under);
+    EXPECT_GE(found, 150);
+    EXPECT_EQ(under, 0);
+  }
+}
+
 // GraphOptions::climb_frontiers: a walled flight ending at a landing with a wall ahead (the first
 // flight of a U-shaped stair), seen from the floor. The back of each tread near the sensor's
 // height is shadowed by the next riser: the treads are support, but C_reach does not join them

@@ -53,10 +53,11 @@ struct SetAside {
   std::vector<Eigen::Vector3f> p;
   double t = 0;
 };
-SetAside set_aside_one(LocalPlanner& lp, const Harness& h, const Eigen::Vector3f& foot) {
+SetAside set_aside_one(LocalPlanner& lp, const Harness& h, const Eigen::Vector3f& foot,
+                       double t0 = 0) {
   SetAside s;
   const auto view = h.map.view();
-  double t = 0;
+  double t = t0;
   for (int k = 0; k < 8 && lp.set_aside().empty(); ++k) {
     const LocalPlanResult r = lp.plan(input(h, view, foot, t));
     t = r.status == LocalPlanStatus::kNewTrajectory ? r.trajectory.t_end() + 10.0 : t + 10.0;
@@ -71,6 +72,14 @@ SetAside set_aside_one(LocalPlanner& lp, const Harness& h, const Eigen::Vector3f
     s.p.push_back(e.p_m);
   }
   return s;
+}
+
+// Set-asides that expire after 30 s once the robot stands more than 2 m from where it was.
+LocalPlannerOptions timed_expiry() {
+  LocalPlannerOptions o;
+  o.set_aside_expiry_s = 30.0;
+  o.set_aside_expiry_move_m = 2.0;
+  return o;
 }
 
 size_t still_set_aside(const LocalPlanner& lp, const SetAside& s) {
@@ -126,10 +135,7 @@ TEST(LocalPlanner, SetAsideExpiresAfterTheTimeoutOnlyOnceTheRobotMoved) {
   Harness h;
   const Eigen::Vector3f foot(0, 0, 0);
   h.observe(w, foot, 40000, 1);
-  LocalPlannerOptions o;
-  o.set_aside_expiry_s = 30.0;
-  o.set_aside_expiry_move_m = 2.0;
-  LocalPlanner lp(RobotModel{}, PlanOptions{}, 0.1, o);
+  LocalPlanner lp(RobotModel{}, PlanOptions{}, 0.1, timed_expiry());
   const SetAside s = set_aside_one(lp, h, foot);
   ASSERT_FALSE(s.p.empty());
   const auto view = h.map.view();
@@ -147,6 +153,41 @@ TEST(LocalPlanner, SetAsideExpiresAfterTheTimeoutOnlyOnceTheRobotMoved) {
   const LocalPlanResult r = lp.plan(input(h, view, moved, s.t + 61.0));
   EXPECT_EQ(r.set_aside_expired, int(s.p.size()));
   EXPECT_EQ(still_set_aside(lp, s), 0u);
+}
+
+// PlanOptions::set_aside_backoff: a frontier set aside unresolved again where it was set aside
+// before waits twice as long before a move away releases it (the maze's blind-ring hole drew the
+// robot back every 30 s). Without the key every set-aside expires after 30 s.
+TEST(LocalPlanner, SetAsideAgainAtTheSamePlaceWaitsTwiceAsLongWithBackoff) {
+  const World w = corridor();
+  for (const bool backoff : {false, true}) {
+    SCOPED_TRACE(backoff ? "backoff" : "no backoff");
+    Harness h;
+    const Eigen::Vector3f foot(0, 0, 0);
+    h.observe(w, foot, 40000, 1);
+    PlanOptions po;
+    po.set_aside_backoff = backoff;
+    LocalPlanner lp(RobotModel{}, po, 0.1, timed_expiry());
+    const auto view = h.map.view();
+    const Eigen::Vector3f moved(2.5f, 0, 0);  // along the corridor, clear of its walls
+    double t0 = 0;
+    // The same frontier set aside three times: 30 s, then 60 s and 120 s with backoff.
+    for (int round = 0; round < 3; ++round) {
+      SCOPED_TRACE("round " + std::to_string(round));
+      const SetAside s = set_aside_one(lp, h, foot, t0);
+      ASSERT_FALSE(s.p.empty());
+      const double expiry = backoff ? 30.0 * double(1 << round) : 30.0;
+      for (const SetAsideEntry& e : lp.set_aside()) EXPECT_EQ(e.expiry_s, expiry);
+      lp.drop_target();
+      EXPECT_EQ(lp.plan(input(h, view, moved, s.t + expiry - 1.0)).set_aside_expired, 0);
+      EXPECT_EQ(still_set_aside(lp, s), s.p.size());
+      lp.drop_target();
+      EXPECT_EQ(lp.plan(input(h, view, moved, s.t + expiry + 1.0)).set_aside_expired,
+                int(s.p.size()));
+      EXPECT_EQ(still_set_aside(lp, s), 0u);
+      t0 = s.t + expiry + 2.0;
+    }
+  }
 }
 
 TEST(LocalPlanner, TargetIsKeptWhenItsClusterOnlyChangedItsId) {

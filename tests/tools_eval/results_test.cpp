@@ -66,6 +66,16 @@ TEST(Results, FloorTimeIsTheTimeOnTheFloorFromTrackingCsv) {
   const RunOutcome o = load_outcome(RunSpec{}, dir);
   ASSERT_EQ(o.status, RunStatus::finished);
   EXPECT_NEAR(o.metrics.per_floor[1].time_on_floor_s, 215.0, 0.25);
+  // The runner's eval.json keeps them: a copy of the record without tracking.csv (an archive
+  // such as docs/eval/) loads the same figures.
+  write_eval_record(o, dir, {"storey", "sim"});
+  const std::string kept = test::fresh_dir("onfloor_kept");
+  for (const char* f : {"metrics.json", "eval.json", "report.md"})
+    fs::copy_file(dir + "/" + f, kept + "/" + f);
+  const RunOutcome k = load_outcome(RunSpec{}, kept);
+  ASSERT_EQ(k.status, RunStatus::finished);
+  EXPECT_NEAR(k.metrics.per_floor[0].time_on_floor_s, 211.0, 0.25);
+  EXPECT_NEAR(k.metrics.per_floor[1].time_on_floor_s, 215.0, 0.25);
 }
 
 TEST(Results, ReadsTheSimulatorsMetricsJson) {
@@ -148,7 +158,8 @@ struct Fixture {
   Fixture() {
     const double t[] = {500, 530, 560}, f1[] = {260, 270, 280}, f2[] = {470, 490, 510};
     for (uint64_t k = 0; k < 3; ++k) {
-      const auto m = test::fixture_metrics(t[k], 400 + 10.0 * double(k), f1[k], f2[k]);
+      auto m = test::fixture_metrics(t[k], 400 + 10.0 * double(k), f1[k], f2[k]);
+      m.commit = k == 2 ? "bbbbbbbbbbbb" : "aaaaaaaaaaaa";  // a matrix resumed on newer code
       add({"two", "storey", "", k + 1}, &m);
     }
     for (uint64_t k = 0; k < 3; ++k)
@@ -181,6 +192,12 @@ TEST(Results, MarkdownTablesShapedLikeThePapers) {
           "| two | storey | 3/3 | Yes | 1+2 | done 3 | 530 ± 30 | 410 ± 10 | 250 ± 0 | 600 ± 0 | "
           "94.0 ± 0.0 | 0 / 0 |"),
       std::string::npos)
+      << md;
+  // The commits the finished runs were built from, and a warning when they differ (the other
+  // fixture runs carry none).
+  EXPECT_NE(md.find("Built from commits `aaaaaaaaaaaa` (2 runs), `bbbbbbbbbbbb` (1 run), `not "
+                    "recorded` (6 runs): **runs from different code are mixed**."),
+            std::string::npos)
       << md;
   // All failed: n/a with the count, in every metric cell.
   EXPECT_NE(

@@ -260,6 +260,20 @@ std::string results_markdown(const ResultsInput& in) {
         "that left no complete metrics.json (or whose record says \"run failed\") is failed and "
         "left out of the means. A floor counts as explored at 90 % ground-truth traversable "
         "coverage.\n\n";
+  // Which code the finished runs came from (metrics.json's commit): a resumed matrix can mix.
+  std::map<std::string, int> commits;
+  for (const auto& o : in.outcomes)
+    if (o.status == RunStatus::finished)
+      ++commits[o.metrics.commit.empty() ? "not recorded" : o.metrics.commit];
+  if (!commits.empty()) {
+    md << "Built from commit" << (commits.size() > 1 ? "s " : " ");
+    bool first = true;
+    for (const auto& [c, n] : commits) {
+      md << (first ? "" : ", ") << "`" << c << "` (" << n << " run" << (n == 1 ? "" : "s") << ")";
+      first = false;
+    }
+    md << (commits.size() > 1 ? ": **runs from different code are mixed**" : "") << ".\n\n";
+  }
 
   auto time_of = [](const MetricsRecord& m) { return m.exploration_time_s; };
   auto dist_of = [](const MetricsRecord& m) { return m.trajectory_length_m; };

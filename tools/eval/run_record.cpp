@@ -82,6 +82,7 @@ std::optional<MetricsRecord> read_metrics_json(const std::string& path, std::str
     m.walking_time_s = w->number();
   // Not written by tools/sim today; read when a later metrics.json carries it.
   if (const JsonValue* r = j.find("end_reason"); r && r->is_string()) m.end_reason = r->string();
+  if (const JsonValue* r = j.find("commit"); r && r->is_string()) m.commit = r->string();
   return m;
 }
 
@@ -178,7 +179,8 @@ RunOutcome load_outcome(const RunSpec& spec, const std::string& dir) {
   std::string err;
   if (auto m = read_metrics_json(dir + "/metrics.json", &err)) {
     o.metrics = std::move(*m);
-    add_time_on_floor(dir + "/tracking.csv", o.metrics);
+    if (!add_time_on_floor(dir + "/tracking.csv", o.metrics))
+      add_time_on_floor_from_eval(dir + "/eval.json", o.metrics);
     o.status = RunStatus::finished;
     o.reason = o.metrics.end_reason.empty() ? read_report_outcome(dir + "/report.md")
                                             : o.metrics.end_reason;
@@ -204,7 +206,29 @@ void write_eval_record(const RunOutcome& o, const std::string& dir,
     << ",\n  \"exit_code\": " << o.exit_code << ",\n  \"reason\": " << json_quote(o.reason)
     << ",\n  \"wall_s\": " << json_number(o.wall_s) << ",\n  \"command\": [";
   for (size_t i = 0; i < command.size(); ++i) f << (i ? ", " : "") << json_quote(command[i]);
-  f << "]\n}\n";
+  f << "]";
+  // Table II's figures, kept here too: an archive of a run without its tracking.csv still has them.
+  if (auto m = read_metrics_json(dir + "/metrics.json", nullptr);
+      m && add_time_on_floor(dir + "/tracking.csv", *m)) {
+    f << ",\n  \"time_on_floor_s\": [";
+    for (size_t i = 0; i < m->per_floor.size(); ++i)
+      f << (i ? ", " : "") << json_number(m->per_floor[i].time_on_floor_s);
+    f << "]";
+  }
+  f << "\n}\n";
+}
+
+bool add_time_on_floor_from_eval(const std::string& path, MetricsRecord& m) {
+  std::string text;
+  JsonValue ev;
+  if (!read_file(path, text) || !parse_json(text, ev, nullptr)) return false;
+  const JsonValue* a = ev.find("time_on_floor_s");
+  if (!a || !a->is_array() || a->array().size() != m.per_floor.size()) return false;
+  for (size_t i = 0; i < m.per_floor.size(); ++i) {
+    const JsonValue& v = a->array()[i];
+    m.per_floor[i].time_on_floor_s = v.is_number() ? v.number() : std::nan("");
+  }
+  return true;
 }
 
 }  // namespace storey::tools::eval

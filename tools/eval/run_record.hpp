@@ -37,6 +37,7 @@ struct MetricsRecord {
   double walking_time_s = std::nan("");
   std::vector<std::pair<double, double>> coverage_over_time;  // (t [s], coverage 0..1)
   std::string end_reason;                                     // "" when not recorded
+  std::string commit;  // the storey build's commit; "" in records from before session 34
 };
 
 // A metrics.json is complete when it parses as a whole and holds every field above (a record cut
@@ -47,6 +48,10 @@ std::optional<MetricsRecord> read_metrics_json(const std::string& path, std::str
 // nothing changed) when the file is missing or has no sample.
 constexpr double kOnFloorM = 0.3;
 bool add_time_on_floor(const std::string& tracking_csv_path, MetricsRecord& m);
+// The same figures as kept in the runner's eval.json ("time_on_floor_s", one per floor, null for
+// a floor never at 90 %), for a record kept without its tracking.csv (a results archive such as
+// docs/eval/). False (nothing changed) when eval.json has none for every floor.
+bool add_time_on_floor_from_eval(const std::string& eval_json_path, MetricsRecord& m);
 // The reason after "Outcome: **...** - " in report.md; "" when there is none.
 std::string read_report_outcome(const std::string& report_md_path);
 // The last non-empty line of a text file (a failed child's reason); "" when none.

@@ -86,7 +86,7 @@ std::string metrics_json(const RunMetrics& m) {
   };
   s += "{\n  \"method\": \"" + str(m.method) + "\",\n  \"ablation\": \"" + str(m.ablation) +
        "\",\n  \"completed\": " + (m.completed ? "true" : "false") + ",\n  \"end_reason\": \"" +
-       str(m.end_reason) + "\",\n";
+       str(m.end_reason) + "\",\n  \"commit\": \"" + str(m.commit) + "\",\n";
   add("  \"success\": %s,\n  \"floors_total\": %d,\n  \"floors_explored\": %d,\n",
       m.success ? "true" : "false", m.floors_total, m.floors_explored);
   add("  \"exploration_time_s\": %.3f,\n  \"trajectory_length_m\": %.3f,\n", m.exploration_time_s,

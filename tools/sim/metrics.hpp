@@ -64,6 +64,7 @@ struct RunMetrics {
   // (exploration_policy.hpp), the ablation ("" = none), whether the planner reported exploration
   // complete, and the one-line reason the run ended.
   std::string method = "storey", ablation, end_reason;
+  std::string commit;  // the storey build's commit (firmware::build_commit())
   bool completed = false;
   int floors_total = 0, floors_explored = 0;
   double exploration_time_s = 0.0, trajectory_length_m = 0.0;

@@ -224,7 +224,7 @@ void write_record(const RecordInputs& in, std::vector<std::string>& written) {
   r << "Command: `storey sim --scene " << in.opt->scene << " --method " << in.opt->method
     << " --sensor " << in.opt->sensor << " --seed " << in.opt->seed << " --time-limit "
     << in.opt->time_limit_s << (in.opt->ablation.empty() ? "" : " --ablation " + in.opt->ablation)
-    << "`\n\n";
+    << "` (commit " << m.commit << ")\n\n";
   r << "Outcome: **" << (m.success ? "success" : "no success") << "** - " << in.result->end_reason
     << "\n\n";
   if (!in.error.empty()) r << "Run failed: `" << in.error << "`\n\n";
@@ -524,6 +524,7 @@ SimRunResult run_exploration(const SimRunOptions& opt) {
     m.latency.push_back(l);
   }
   m.method = opt.method;
+  m.commit = firmware::build_commit();
   m.ablation = opt.ablation;
   m.completed = res.completed;
   m.end_reason = res.end_reason;
