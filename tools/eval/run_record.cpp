@@ -21,6 +21,16 @@ bool read_file(const std::string& path, std::string& out) {
   return bool(f) || f.eof();
 }
 
+// Table II's floor times as write_eval_record keeps them in eval.json.
+bool time_on_floor_from_eval(const JsonValue& ev, MetricsRecord& m) {
+  const JsonValue* a = ev.find("time_on_floor_s");
+  if (!a || !a->is_array() || a->array().size() != m.per_floor.size()) return false;
+  for (size_t i = 0; i < m.per_floor.size(); ++i) {
+    const JsonValue& v = a->array()[i];
+    m.per_floor[i].time_on_floor_s = v.is_number() ? v.number() : std::nan("");
+  }
+  return true;
+}
 }  // namespace
 
 std::optional<MetricsRecord> read_metrics_json(const std::string& path, std::string* error) {
@@ -179,8 +189,8 @@ RunOutcome load_outcome(const RunSpec& spec, const std::string& dir) {
   std::string err;
   if (auto m = read_metrics_json(dir + "/metrics.json", &err)) {
     o.metrics = std::move(*m);
-    if (!add_time_on_floor(dir + "/tracking.csv", o.metrics))
-      add_time_on_floor_from_eval(dir + "/eval.json", o.metrics);
+    if (!add_time_on_floor(dir + "/tracking.csv", o.metrics) && have_eval)
+      time_on_floor_from_eval(ev, o.metrics);
     o.status = RunStatus::finished;
     o.reason = o.metrics.end_reason.empty() ? read_report_outcome(dir + "/report.md")
                                             : o.metrics.end_reason;
@@ -216,19 +226,6 @@ void write_eval_record(const RunOutcome& o, const std::string& dir,
     f << "]";
   }
   f << "\n}\n";
-}
-
-bool add_time_on_floor_from_eval(const std::string& path, MetricsRecord& m) {
-  std::string text;
-  JsonValue ev;
-  if (!read_file(path, text) || !parse_json(text, ev, nullptr)) return false;
-  const JsonValue* a = ev.find("time_on_floor_s");
-  if (!a || !a->is_array() || a->array().size() != m.per_floor.size()) return false;
-  for (size_t i = 0; i < m.per_floor.size(); ++i) {
-    const JsonValue& v = a->array()[i];
-    m.per_floor[i].time_on_floor_s = v.is_number() ? v.number() : std::nan("");
-  }
-  return true;
 }
 
 }  // namespace storey::tools::eval

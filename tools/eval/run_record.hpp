@@ -48,10 +48,6 @@ std::optional<MetricsRecord> read_metrics_json(const std::string& path, std::str
 // nothing changed) when the file is missing or has no sample.
 constexpr double kOnFloorM = 0.3;
 bool add_time_on_floor(const std::string& tracking_csv_path, MetricsRecord& m);
-// The same figures as kept in the runner's eval.json ("time_on_floor_s", one per floor, null for
-// a floor never at 90 %), for a record kept without its tracking.csv (a results archive such as
-// docs/eval/). False (nothing changed) when eval.json has none for every floor.
-bool add_time_on_floor_from_eval(const std::string& eval_json_path, MetricsRecord& m);
 // The reason after "Outcome: **...** - " in report.md; "" when there is none.
 std::string read_report_outcome(const std::string& report_md_path);
 // The last non-empty line of a text file (a failed child's reason); "" when none.
@@ -78,9 +74,11 @@ struct RunOutcome {
 };
 
 // Reads a run folder (DIR/runs/...): finished when metrics.json is complete; failed when the
-// runner's eval.json says so; not_run otherwise.
+// runner's eval.json says so; not_run otherwise. Table II's floor times come from tracking.csv,
+// else from eval.json (a record kept without its tracking.csv, such as docs/eval/).
 RunOutcome load_outcome(const RunSpec& spec, const std::string& run_dir);
-// Writes run_dir/eval.json for `o` (status, exit code, reason, wall time, the command).
+// Writes run_dir/eval.json for `o` (status, exit code, reason, wall time, the command, and Table
+// II's time on each floor when the folder has metrics.json and tracking.csv).
 void write_eval_record(const RunOutcome& o, const std::string& run_dir,
                        const std::vector<std::string>& command);
 
