@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/plan/escape.hpp"
+#include "core/plan/local_planner.hpp"
 #include "core/plan/path_centring.hpp"
 #include "core/plan/plan_config.hpp"
 
@@ -46,12 +47,25 @@ bool GoalDriver::keep(const plan::ExplorationInput& in, const std::vector<Goal>&
   const bool reached = dist_xy(in.robot_foot_m, target_.p_m) <= opt_.reached_radius_m &&
                        std::abs(in.robot_foot_m.z() - target_.p_m.z()) < 0.5;
   if (reached) {
-    // Stood there and the frontier is still one: nothing more to see from reachable ground.
-    if (still_goal) {
-      add_set_aside(target_.key_m), add_set_aside(target_.p_m);
-      ++counts_.stood_at;
-    }
     has_target_ = false;
+    if (!still_goal) return false;
+    if (approach_frontier_ && dist_xy(target_.p_m, target_.key_m) > opt_.reached_radius_m &&
+        std::none_of(approached_.begin(), approached_.end(),
+                     [&](const Eigen::Vector3d& a) { return near(a, target_.key_m, 0.5); })) {
+      // Stood at its viewpoint and the frontier is still one: walk onto it once.
+      approached_.push_back(target_.key_m);
+      Goal onto = target_;
+      onto.p_m = target_.key_m;
+      onto.path_m.clear();
+      if (drive(in, onto, r)) {
+        adopt(in, onto, r);
+        r.reason = "onto the frontier: still one from its viewpoint";
+        return true;
+      }
+    }
+    // Stood there and the frontier is still one: nothing more to see from reachable ground.
+    add_set_aside(target_.key_m), add_set_aside(target_.p_m);
+    ++counts_.stood_at;
     return false;
   }
   if (!still_goal) {
@@ -65,6 +79,20 @@ bool GoalDriver::keep(const plan::ExplorationInput& in, const std::vector<Goal>&
     return false;
   }
   if (in.t_s - planned_at_s_ >= opt_.replan_period_s) {
+    has_target_ = false;
+    return false;
+  }
+  // The map has grown since the trajectory was planned (a wall seen late, at a corner): re-check
+  // what is left of it, on the plan-time check's sample grid as the local layer does, and replan
+  // at once if it now collides rather than follow it until the periodic replan.
+  const double t_on =
+      in.t_s - std::clamp(in.trajectory_lag_s, 0.0, plan::LocalPlanner::kMaxReferenceLagS);
+  const double t_from = std::clamp(t_on, traj_.t_start(), traj_.t_end());
+  if (!traj_.empty() && checker_
+                            .check_on_grid(
+                                *in.view, [&](double t) { return traj_.pose(t); }, traj_.t_start(),
+                                traj_.t_end(), t_from, traj_.t_end() - t_from)
+                            .collides) {
     has_target_ = false;
     return false;
   }
@@ -112,6 +140,15 @@ bool GoalDriver::drive(const plan::ExplorationInput& in, const Goal& g,
   return true;
 }
 
+void GoalDriver::adopt(const plan::ExplorationInput& in, const Goal& g,
+                       const plan::ExplorationResult& r) {
+  has_target_ = true;
+  target_ = g;
+  planned_at_s_ = in.t_s;
+  traj_end_s_ = r.trajectory.t_end();
+  traj_ = r.trajectory;
+}
+
 void GoalDriver::choose(const plan::ExplorationInput& in, std::vector<Goal>& goals,
                         plan::ExplorationResult& r) {
   std::erase_if(goals, [&](const Goal& g) { return set_aside(g); });
@@ -135,10 +172,7 @@ void GoalDriver::choose(const plan::ExplorationInput& in, std::vector<Goal>& goa
   for (const Goal& g : goals) {
     if (attempts++ >= opt_.max_attempts) break;
     if (drive(in, g, r)) {
-      has_target_ = true;
-      target_ = g;
-      planned_at_s_ = in.t_s;
-      traj_end_s_ = r.trajectory.t_end();
+      adopt(in, g, r);
       r.reason = "new frontier target";
       return;
     }

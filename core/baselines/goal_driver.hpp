@@ -58,8 +58,10 @@ class GoalDriver {
 
   // Keep the current target? Call first each cycle with the goals of this cycle. Returns true
   // (and fills r as kKeep) if the target is still a goal (a goal key within set_aside_radius_m),
-  // not reached, not overdue and younger than replan_period_s. Reaching a target whose frontier
-  // is still a goal sets it aside (not observable from where the robot can stand).
+  // not reached, not overdue, younger than replan_period_s and its trajectory still free on this
+  // map. Reaching a target whose frontier is still a goal sets it aside (not observable from
+  // where the robot can stand), after walking onto the frontier with set_approach_frontier (then
+  // r is kNewTrajectory and true is returned).
   bool keep(const plan::ExplorationInput& in, const std::vector<Goal>& goals,
             plan::ExplorationResult& r);
   // Goals in cost order minus set-aside ones; tries Stage 3 on them (at most max_attempts) and
@@ -88,6 +90,11 @@ class GoalDriver {
   // Optional path where the voxel A* finds none (tare-like: along its own viewpoint graph, as
   // TARE plans; on a sparsely seen ramp the voxel A* fails where the graph still connects).
   // Returns support points from near the robot to the goal, or none.
+  // Walk onto the frontier itself when its viewpoint was reached and it is still a goal, before
+  // setting it aside (as the local layer does: the LiDAR's blind ring moves with the robot, so
+  // ground beyond a frontier is often seen only from on it). Needs goals whose key_m is a place
+  // to stand (tare-like's frontier node, nearest-frontier's member voxel).
+  void set_approach_frontier(bool on) { approach_frontier_ = on; }
   void set_fallback_path(
       std::function<std::vector<Eigen::Vector3d>(const plan::ExplorationInput&, const Goal&)> f) {
     fallback_ = std::move(f);
@@ -95,6 +102,7 @@ class GoalDriver {
 
  private:
   void add_set_aside(const Eigen::Vector3d& key_m) { set_aside_.push_back(key_m); }
+  void adopt(const plan::ExplorationInput& in, const Goal& g, const plan::ExplorationResult& r);
 
   RobotModel robot_;
   BaselineOptions opt_;
@@ -107,6 +115,9 @@ class GoalDriver {
   bool has_target_ = false;
   Goal target_;
   double planned_at_s_ = 0, traj_end_s_ = 0;
+  plan::BsplineTrajectory traj_;  // the trajectory to the current target, re-checked in keep()
+  bool approach_frontier_ = false;
+  std::vector<Eigen::Vector3d> approached_;  // frontier keys walked onto (set_approach_frontier)
   std::vector<Eigen::Vector3d> set_aside_;
   SetAsideCounts counts_;
   std::vector<std::pair<Eigen::Vector3d, int>> failures_;

@@ -14,11 +14,13 @@ uint64_t pack(const map::VoxelKey& k) {
          uint64_t(uint32_t(k.z) & 0x1FFFFF);
 }
 // Column (x, y) has no known ground at level z (the robot's level there): no voxel from z - 1
-// to z + 1 is occupied with a decided state, and either the voxel at z was never observed or
-// the ground there is under-observed (S_unobs, N(v) < N_min: seen by a few rays only, as at the
-// edge of what the LiDAR reached). A VLP-16 leaves such gaps between its rings on the floor
-// (rays pass above them: the space is known free, the ground is not). A known drop (the voxel
-// seen free) or a wall is not a frontier.
+// to z + 1 is occupied with a decided state, and either the ground there is under-observed
+// (S_unobs, N(v) < N_min: seen by a few rays only, as at the edge of what the LiDAR reached) or
+// nothing below the level was seen free. A VLP-16 leaves gaps between its rings on the floor:
+// rays bound for the next ring graze the floor's own voxel (z) and carve it free, but none goes
+// below it, so the ground there is unknown, not absent (maze seeds 2, 4, 5 ended "complete" at
+// 4 s when a free voxel at z alone meant a drop). A drop is known only once a ray has passed
+// below the level (z - 1 seen free); a wall is never a frontier.
 bool unknown_column(const map::MapView& view, int32_t x, int32_t y, int32_t z) {
   bool unobserved = false;
   for (int32_t dz = -1; dz <= 1; ++dz) {
@@ -27,7 +29,8 @@ bool unknown_column(const map::MapView& view, int32_t x, int32_t y, int32_t z) {
     if (view.state(k) != map::TravState::kUnobserved) return false;
     unobserved = true;
   }
-  return unobserved || view.occupancy(map::VoxelKey{x, y, z}) == map::Occupancy::kUnknown;
+  return unobserved || view.occupancy(map::VoxelKey{x, y, z}) == map::Occupancy::kUnknown ||
+         view.occupancy(map::VoxelKey{x, y, z - 1}) != map::Occupancy::kFree;
 }
 }  // namespace
 

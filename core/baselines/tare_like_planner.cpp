@@ -34,6 +34,8 @@ TareLikePlanner::TareLikePlanner(const RobotModel& robot, const plan::PlanOption
     : opt_(options),
       driver_(robot, plan, voxel_size_m, options),
       tsp_(plan::TspOptions{plan.tsp_exact_max_n}) {
+  // Its goals stand at a cluster's viewpoint; key_m is the frontier node, a place to stand.
+  driver_.set_approach_frontier(true);
   const double th = options.height_threshold_m, sp = options.link_spacing_m;
   driver_.set_path_filter(
       [th, sp](const std::vector<Eigen::Vector3d>& p) { return tare_path_ok(p, th, sp); });

@@ -94,6 +94,42 @@ TEST(NearestFrontier, PicksTheNearerOfTwoFrontiers) {
   EXPECT_GT(s.target_m.x(), 3.0);
 }
 
+// Rays bound for a far ring of the floor graze the floor's own voxel layer before they hit and
+// carve it free, but none passes below it: the ground there is unknown, not a known drop, and
+// the frontier stays (maze seeds 2, 4 and 5 ended "complete" at 4 s when it did not).
+TEST(NearestFrontier, FloorCarvedByGrazingRaysIsStillAFrontier) {
+  World w;  // floor top at 3 cm: its returns all land in the voxel layer [0, 0.1] m
+  w.add(aabb({-12, -1.5f, -0.2f}, {12, 1.5f, 0.03f}));
+  w.add(aabb({-12, -1.7f, 0}, {12, -1.5f, 2.5f}));
+  w.add(aabb({-12, 1.5f, 0}, {12, 1.7f, 2.5f}));
+  map::TraversabilityMap m;
+  scan(m, w, {{0, 0, 0.5f}, {2, 0, 0.5f}}, 4.0f);
+  // Rays from x = 6.5, 6 cm up, to floor points at x = 4.2: they cross the layer [0, 0.1] m
+  // from x = 6.5 to 4.3 without ever going below the floor.
+  for (int rep = 0; rep < 5; ++rep)
+    for (float y0 = -1.4f; y0 <= 1.4f; y0 += 0.2f) {
+      std::vector<Eigen::Vector3f> pts;
+      for (float y = -1.45f; y <= 1.45f; y += 0.05f) pts.push_back({4.2f, y, 0.035f});
+      m.insert_scan(Eigen::Vector3f(6.5f, y0, 0.06f), pts);
+    }
+  m.update_traversability();
+  m.update_reachable(Eigen::Vector3f(0, 0, 0));
+  const map::MapView view = m.view();
+  const Eigen::Vector3f edge(4.2f, 0, 0.05f), beyond(4.6f, 0, 0.05f);
+  ASSERT_TRUE(view.is_reachable(view.key_of(edge)));
+  ASSERT_EQ(view.occupancy(view.key_of(beyond)), map::Occupancy::kFree);
+  ASSERT_NE(view.occupancy(view.key_of(beyond - Eigen::Vector3f(0, 0, 0.1f))),
+            map::Occupancy::kFree);
+  // The reachable floor's last voxels at x = 4.2 border the carved layer: frontier voxels.
+  int at_edge = 0;
+  for (const auto& c : volumetric_frontiers(view, 4))
+    for (const map::VoxelKey& k : c.voxels) {
+      const Eigen::Vector3f p = view.centre_of(k);
+      at_edge += p.x() > 4.1f && std::abs(p.y()) < 1.0f;  // voxel x in [4.1, 4.2]
+    }
+  EXPECT_GE(at_edge, 10);
+}
+
 // Floor with stairs rising along +x from x = 1 (6 steps, 0.17 m rise, 0.28 m tread) to a
 // landing: on the start floor's 2D grid the treads are obstacles, the floor is free, and no
 // fael-like goal lies above the floor's band.
@@ -173,6 +209,70 @@ TEST(GoalDriver, FallbackPathOnlyWhereTheVoxelAStarFails) {
   GoalDriver plain(RobotModel{}, plan::PlanOptions{}, 0.1, BaselineOptions{});
   plan::ExplorationResult n;
   EXPECT_FALSE(plain.drive(in, in_the_air, n));
+}
+
+// A kept target's trajectory is re-checked on each new map: a box seen across it since it was
+// planned ends the keep at once (the robot followed it into walls seen late until the periodic
+// replan: 18 collisions in 200 s, maze seed 4).
+TEST(GoalDriver, KeepEndsWhenTheMapNowBlocksTheTrajectory) {
+  const World open = corridor_along_x(6);
+  World blocked = corridor_along_x(6);
+  blocked.add(aabb({1.4f, -1.5f, 0}, {1.8f, 1.5f, 1.0f}));
+  map::TraversabilityMap a, b;
+  scan(a, open, {{0, 0, 0.5f}, {3, 0, 0.5f}}, 6.0f);
+  scan(b, blocked, {{0, 0, 0.5f}, {3, 0, 0.5f}}, 6.0f);
+  const map::MapView va = a.view(), vb = b.view();
+  GoalDriver d(RobotModel{}, plan::PlanOptions{}, 0.1, BaselineOptions{});
+  Goal g;
+  g.p_m = g.key_m = {3, 0, 0};
+  std::vector<Goal> goals{g};
+  plan::ExplorationResult r;
+  d.choose(input_at(va, {0, 0, 0}), goals, r);
+  ASSERT_EQ(r.status, plan::ExplorationStatus::kNewTrajectory) << r.reason;
+  plan::ExplorationInput later = input_at(va, {0, 0, 0});
+  later.t_s = 1.5;
+  plan::ExplorationResult k;
+  EXPECT_TRUE(d.keep(later, goals, k));  // same map: kept
+  EXPECT_EQ(k.status, plan::ExplorationStatus::kKeep);
+  later.view = &vb;
+  later.t_s = 2.0;
+  plan::ExplorationResult k2;
+  EXPECT_FALSE(d.keep(later, goals, k2));  // the box across it: replan
+  EXPECT_FALSE(d.has_target());
+}
+
+// set_approach_frontier: a viewpoint reached while its frontier is still a goal sends the robot
+// onto the frontier once; reached there and still a goal, it is set aside.
+TEST(GoalDriver, WalksOntoAFrontierStillThereFromItsViewpoint) {
+  const World w = corridor_along_x(6);
+  map::TraversabilityMap m;
+  scan(m, w, {{0, 0, 0.5f}, {3, 0, 0.5f}}, 6.0f);
+  const map::MapView view = m.view();
+  for (const bool approach : {true, false}) {
+    GoalDriver d(RobotModel{}, plan::PlanOptions{}, 0.1, BaselineOptions{});
+    d.set_approach_frontier(approach);
+    Goal g;
+    g.p_m = {0.5, 0, 0};    // its viewpoint
+    g.key_m = {2.5, 0, 0};  // the frontier itself
+    std::vector<Goal> goals{g};
+    plan::ExplorationResult r;
+    d.choose(input_at(view, {0, 0, 0}), goals, r);
+    ASSERT_EQ(r.status, plan::ExplorationStatus::kNewTrajectory) << r.reason;
+    plan::ExplorationInput at_view = input_at(view, {0.5, 0, 0});
+    at_view.t_s = 4.0;
+    plan::ExplorationResult k;
+    EXPECT_EQ(d.keep(at_view, goals, k), approach) << k.reason;
+    EXPECT_EQ(d.set_aside(g), !approach);
+    if (!approach) continue;
+    ASSERT_EQ(k.status, plan::ExplorationStatus::kNewTrajectory);
+    EXPECT_LT((k.target_m - g.key_m).norm(), 1e-9);
+    plan::ExplorationInput on_it = input_at(view, {2.5, 0, 0});
+    on_it.t_s = 7.0;
+    plan::ExplorationResult k2;
+    EXPECT_FALSE(d.keep(on_it, goals, k2));
+    EXPECT_TRUE(d.set_aside(g));
+    EXPECT_EQ(d.set_aside_counts().stood_at, 1u);
+  }
 }
 
 TEST(Baselines, BadInputFails) {
