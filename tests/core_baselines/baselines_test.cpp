@@ -1,6 +1,8 @@
 // The baselines of core/baselines/ on synthetic LiDAR worlds: behaviour that tells them apart.
 #include <gtest/gtest.h>
 
+#include <memory>
+
 #include "core/baselines/fael_like_planner.hpp"
 #include "core/baselines/nearest_frontier_planner.hpp"
 #include "core/baselines/tare_like_planner.hpp"
@@ -211,6 +213,17 @@ TEST(GoalDriver, FallbackPathOnlyWhereTheVoxelAStarFails) {
   EXPECT_FALSE(plain.drive(in, in_the_air, n));
 }
 
+// A GoalDriver that chose g (its only goal) from the robot at the origin, or null if it did not.
+std::unique_ptr<GoalDriver> driving_to(const map::MapView& view, const Goal& g, bool approach) {
+  auto d = std::make_unique<GoalDriver>(RobotModel{}, plan::PlanOptions{}, 0.1, BaselineOptions{});
+  d->set_approach_frontier(approach);
+  std::vector<Goal> goals{g};
+  plan::ExplorationResult r;
+  d->choose(input_at(view, {0, 0, 0}), goals, r);
+  if (r.status != plan::ExplorationStatus::kNewTrajectory) return nullptr;
+  return d;
+}
+
 // A kept target's trajectory is re-checked on each new map: a box seen across it since it was
 // planned ends the keep at once (the robot followed it into walls seen late until the periodic
 // replan: 18 collisions in 200 s, maze seed 4).
@@ -222,13 +235,12 @@ TEST(GoalDriver, KeepEndsWhenTheMapNowBlocksTheTrajectory) {
   scan(a, open, {{0, 0, 0.5f}, {3, 0, 0.5f}}, 6.0f);
   scan(b, blocked, {{0, 0, 0.5f}, {3, 0, 0.5f}}, 6.0f);
   const map::MapView va = a.view(), vb = b.view();
-  GoalDriver d(RobotModel{}, plan::PlanOptions{}, 0.1, BaselineOptions{});
   Goal g;
   g.p_m = g.key_m = {3, 0, 0};
-  std::vector<Goal> goals{g};
-  plan::ExplorationResult r;
-  d.choose(input_at(va, {0, 0, 0}), goals, r);
-  ASSERT_EQ(r.status, plan::ExplorationStatus::kNewTrajectory) << r.reason;
+  const std::vector<Goal> goals{g};
+  const auto driver = driving_to(va, g, false);
+  ASSERT_TRUE(driver);
+  GoalDriver& d = *driver;
   plan::ExplorationInput later = input_at(va, {0, 0, 0});
   later.t_s = 1.5;
   plan::ExplorationResult k;
@@ -249,15 +261,13 @@ TEST(GoalDriver, WalksOntoAFrontierStillThereFromItsViewpoint) {
   scan(m, w, {{0, 0, 0.5f}, {3, 0, 0.5f}}, 6.0f);
   const map::MapView view = m.view();
   for (const bool approach : {true, false}) {
-    GoalDriver d(RobotModel{}, plan::PlanOptions{}, 0.1, BaselineOptions{});
-    d.set_approach_frontier(approach);
     Goal g;
     g.p_m = {0.5, 0, 0};    // its viewpoint
     g.key_m = {2.5, 0, 0};  // the frontier itself
-    std::vector<Goal> goals{g};
-    plan::ExplorationResult r;
-    d.choose(input_at(view, {0, 0, 0}), goals, r);
-    ASSERT_EQ(r.status, plan::ExplorationStatus::kNewTrajectory) << r.reason;
+    const std::vector<Goal> goals{g};
+    const auto driver = driving_to(view, g, approach);
+    ASSERT_TRUE(driver);
+    GoalDriver& d = *driver;
     plan::ExplorationInput at_view = input_at(view, {0.5, 0, 0});
     at_view.t_s = 4.0;
     plan::ExplorationResult k;
