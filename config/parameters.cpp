@@ -200,6 +200,7 @@ void read_plan(SectionReader&& r, core::plan::PlanOptions& o) {
   r.get("keep_zone_drive", o.keep_zone_drive);
   r.get("retry_flight_frontiers", o.retry_flight_frontiers);
   r.get("set_aside_backoff", o.set_aside_backoff);
+  r.get("no_views_on_climbed_flights", o.no_views_on_climbed_flights);
   r.get("climb_axis_anew", o.climb_axis_anew);
   r.get("no_progress_s", o.no_progress_s, Range{0.0, 600.0});
   r.get("stale_floor_s", o.stale_floor_s, Range{0.0, 3600.0});

@@ -278,6 +278,7 @@ std::vector<Viewpoint> LocalPlanner::viewpoints_of(const LocalPlanInput& in,
     for (const auto& gv : cv.viewpoints) {
       if (int(v.size()) >= plan_opt_.max_candidates_k) break;
       if (gv.node >= g.node_capacity() || !g.node(gv.node).alive) continue;
+      if (!view_allowed(gv.p_m)) continue;
       v.push_back({gv.p_m.cast<double>(), double(gv.yaw_rad), gv.node});
     }
   }

@@ -207,6 +207,11 @@ class LocalPlanner {
   bool ignored(const Eigen::Vector3f& p) const {
     return set_aside_at(p) != nullptr || on_climbed_flight(p) || on_deferred_flight(p);
   }
+  // A viewpoint that may be a target (PlanOptions::no_views_on_climbed_flights: not on a flight
+  // the robot climbed).
+  bool view_allowed(const Eigen::Vector3f& p) const {
+    return !plan_opt_.no_views_on_climbed_flights || !on_climbed_flight(p);
+  }
   void set_stage_probe(StageProbe* probe) { probe_ = probe; }
 
  private:

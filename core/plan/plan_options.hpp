@@ -178,6 +178,11 @@ struct PlanOptions {
   // last 350 s (seed 1, ground floor 75.9 %; 94.1 % with it). Off: office seed 2's path with it
   // went back onto the flight from its landing and wedged the body (docs/RESULTS.md).
   bool set_aside_backoff = false;
+  // Beyond the paper (session 35): a cluster's viewpoints on a flight the robot climbed are not
+  // targets (its nodes there already are not, LocalPlanner::on_climbed_flight). Right after its
+  // climb office seed 2 (with set_aside_backoff) went back down to a viewpoint on the top tread,
+  // turned on the treads and wedged the body crossing the landing's edge diagonally.
+  bool no_views_on_climbed_flights = false;
   bool incremental_maintenance = true;
 };
 

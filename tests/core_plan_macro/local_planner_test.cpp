@@ -10,6 +10,8 @@
 
 #include <gtest/gtest.h>
 
+#include <functional>
+
 #include "macro_world.hpp"
 
 using namespace storey::core::plan;
@@ -497,10 +499,11 @@ struct FootRun {
   bool climbed = false;  // then a climb ending more than three treads up
 };
 
-FootRun run_flight_foot(bool on) {
+// `after`, if given, sees the planner after one more cycle once the loop has ended.
+FootRun run_flight_foot(bool on, PlanOptions po = {},
+                        const std::function<void(const LocalPlanner&)>& after = {}) {
   Harness h;
   observe_flight_room(h);
-  PlanOptions po;
   po.climb_blind = true;
   po.flight_foot = on;
   const auto view = h.map.view();
@@ -522,9 +525,30 @@ FootRun run_flight_foot(bool on) {
     }
     if (reason.rfind("climb on", 0) == 0 && foot.z() > 0.5f) run.climbed = true;
   }
+  if (after) {  // one more cycle: the climb's end is recorded at the first plan after it
+    walked_cycle(lp, h, view, at_foot, foot, yaw, t);
+    after(lp);
+  }
   return run;
 }
 }  // namespace
+
+// PlanOptions::no_views_on_climbed_flights: once the flight is climbed, a viewpoint on it (here
+// on its third tread, on its axis) is no target; one on the floor beside it still is.
+TEST(LocalPlanner, AViewpointOnAFlightClimbedIsNoTargetWithNoViewsOnClimbedFlights) {
+  for (const bool on : {false, true}) {
+    PlanOptions po;
+    po.no_views_on_climbed_flights = on;
+    bool checked = false;
+    const FootRun run = run_flight_foot(true, po, [&](const LocalPlanner& lp) {
+      checked = true;
+      EXPECT_EQ(lp.view_allowed(Eigen::Vector3f(0.75f, 0, 0.45f)), !on);
+      EXPECT_TRUE(lp.view_allowed(Eigen::Vector3f(-2.0f, 2.0f, 0)));
+    });
+    ASSERT_TRUE(run.climbed);
+    EXPECT_TRUE(checked);
+  }
+}
 
 TEST(LocalPlanner, AFrontierBesideAFlightSendsTheRobotToTheFlightsFootToClimb) {
   const FootRun on = run_flight_foot(true);
