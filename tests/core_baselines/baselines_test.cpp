@@ -213,15 +213,27 @@ TEST(GoalDriver, FallbackPathOnlyWhereTheVoxelAStarFails) {
   EXPECT_FALSE(plain.drive(in, in_the_air, n));
 }
 
-// A GoalDriver that chose g (its only goal) from the robot at the origin, or null if it did not.
-std::unique_ptr<GoalDriver> driving_to(const map::MapView& view, const Goal& g, bool approach) {
-  auto d = std::make_unique<GoalDriver>(RobotModel{}, plan::PlanOptions{}, 0.1, BaselineOptions{});
-  d->set_approach_frontier(approach);
-  std::vector<Goal> goals{g};
+// A GoalDriver that chose its only goal (standing point p, frontier key) from the robot at the
+// origin; driver is null if it did not.
+struct Driving {
+  Goal goal;
+  std::vector<Goal> goals;
+  std::unique_ptr<GoalDriver> driver;
+};
+Driving driving_to(const map::MapView& view, const Eigen::Vector3d& p, const Eigen::Vector3d& key,
+                   bool approach) {
+  Driving run;
+  run.goal.p_m = p;
+  run.goal.key_m = key;
+  run.goals = {run.goal};
+  run.driver =
+      std::make_unique<GoalDriver>(RobotModel{}, plan::PlanOptions{}, 0.1, BaselineOptions{});
+  run.driver->set_approach_frontier(approach);
+  std::vector<Goal> goals = run.goals;
   plan::ExplorationResult r;
-  d->choose(input_at(view, {0, 0, 0}), goals, r);
-  if (r.status != plan::ExplorationStatus::kNewTrajectory) return nullptr;
-  return d;
+  run.driver->choose(input_at(view, {0, 0, 0}), goals, r);
+  if (r.status != plan::ExplorationStatus::kNewTrajectory) run.driver.reset();
+  return run;
 }
 
 // A kept target's trajectory is re-checked on each new map: a box seen across it since it was
@@ -235,12 +247,10 @@ TEST(GoalDriver, KeepEndsWhenTheMapNowBlocksTheTrajectory) {
   scan(a, open, {{0, 0, 0.5f}, {3, 0, 0.5f}}, 6.0f);
   scan(b, blocked, {{0, 0, 0.5f}, {3, 0, 0.5f}}, 6.0f);
   const map::MapView va = a.view(), vb = b.view();
-  Goal g;
-  g.p_m = g.key_m = {3, 0, 0};
-  const std::vector<Goal> goals{g};
-  const auto driver = driving_to(va, g, false);
-  ASSERT_TRUE(driver);
-  GoalDriver& d = *driver;
+  const Driving run = driving_to(va, {3, 0, 0}, {3, 0, 0}, false);
+  ASSERT_TRUE(run.driver);
+  GoalDriver& d = *run.driver;
+  const std::vector<Goal>& goals = run.goals;
   plan::ExplorationInput later = input_at(va, {0, 0, 0});
   later.t_s = 1.5;
   plan::ExplorationResult k;
@@ -261,13 +271,12 @@ TEST(GoalDriver, WalksOntoAFrontierStillThereFromItsViewpoint) {
   scan(m, w, {{0, 0, 0.5f}, {3, 0, 0.5f}}, 6.0f);
   const map::MapView view = m.view();
   for (const bool approach : {true, false}) {
-    Goal g;
-    g.p_m = {0.5, 0, 0};    // its viewpoint
-    g.key_m = {2.5, 0, 0};  // the frontier itself
-    const std::vector<Goal> goals{g};
-    const auto driver = driving_to(view, g, approach);
-    ASSERT_TRUE(driver);
-    GoalDriver& d = *driver;
+    // Its viewpoint at x = 0.5, the frontier itself at x = 2.5.
+    const Driving run = driving_to(view, {0.5, 0, 0}, {2.5, 0, 0}, approach);
+    ASSERT_TRUE(run.driver);
+    GoalDriver& d = *run.driver;
+    const Goal& g = run.goal;
+    const std::vector<Goal>& goals = run.goals;
     plan::ExplorationInput at_view = input_at(view, {0.5, 0, 0});
     at_view.t_s = 4.0;
     plan::ExplorationResult k;
