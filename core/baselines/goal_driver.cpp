@@ -116,6 +116,17 @@ bool GoalDriver::drive(const plan::ExplorationInput& in, const Goal& g,
   std::vector<Eigen::Vector3d> path = g.path_m;
   if (path.empty() || start != in.robot_foot_m) {
     plan::VoxelPath vp = astar_.plan(*in.view, start, g.p_m);
+    if (vp.status == plan::VoxelAStarStatus::kNoStartSupport)
+      // The ground under the robot unseen (inside the LiDAR's blind ring after an escape onto
+      // ground seen only as far as a frontier): search from the nearest passable support around
+      // it instead. Without this every goal failed there and the robot stood still for 1600 s
+      // (office seed 2, nearest-frontier, session 35).
+      for (const Eigen::Vector3d& s : passable_supports_near(*in.view, start, 0.6, 4)) {
+        vp = astar_.plan(*in.view, s, g.p_m);
+        if (vp.status != plan::VoxelAStarStatus::kOk) continue;
+        vp.points_m.insert(vp.points_m.begin(), start);
+        break;
+      }
     if (vp.status == plan::VoxelAStarStatus::kOk && !vp.points_m.empty())
       path = std::move(vp.points_m);
     else if (fallback_)
@@ -138,6 +149,36 @@ bool GoalDriver::drive(const plan::ExplorationInput& in, const Goal& g,
   r.target_m = g.p_m;
   r.target_yaw_rad = g.yaw_rad;
   return true;
+}
+
+std::vector<Eigen::Vector3d> GoalDriver::passable_supports_near(const map::MapView& view,
+                                                                const Eigen::Vector3d& p_m,
+                                                                double radius_m,
+                                                                size_t max_n) const {
+  std::vector<std::pair<double, Eigen::Vector3d>> found;
+  const double step = view.voxel_size_m();
+  const int n = int(std::ceil(radius_m / step));
+  for (int dx = -n; dx <= n; ++dx)
+    for (int dy = -n; dy <= n; ++dy) {
+      const double d = step * std::hypot(dx, dy);
+      if (d > radius_m) continue;
+      const Eigen::Vector3d q = p_m + Eigen::Vector3d(dx * step, dy * step, 0);
+      const auto s = view.support_surface_near(q.cast<float>(), 0.3);
+      if (!s || !astar_.passable(view, s->key, s->height_m)) continue;
+      found.push_back({d, Eigen::Vector3d(q.x(), q.y(), s->height_m)});
+    }
+  std::stable_sort(found.begin(), found.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<Eigen::Vector3d> out;
+  // Spread out: a candidate within 0.25 m of one already taken adds little.
+  for (const auto& [d, q] : found) {
+    if (out.size() >= max_n) break;
+    if (std::any_of(out.begin(), out.end(),
+                    [&](const Eigen::Vector3d& o) { return (o - q).head<2>().norm() < 0.25; }))
+      continue;
+    out.push_back(q);
+  }
+  return out;
 }
 
 void GoalDriver::adopt(const plan::ExplorationInput& in, const Goal& g,

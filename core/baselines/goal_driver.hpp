@@ -103,6 +103,11 @@ class GoalDriver {
  private:
   void add_set_aside(const Eigen::Vector3d& key_m) { set_aside_.push_back(key_m); }
   void adopt(const plan::ExplorationInput& in, const Goal& g, const plan::ExplorationResult& r);
+  // Up to max_n points within radius_m (horizontally) of p_m over support voxels the voxel A* may
+  // stand on, nearest first, at least 0.25 m apart.
+  std::vector<Eigen::Vector3d> passable_supports_near(const map::MapView& view,
+                                                      const Eigen::Vector3d& p_m, double radius_m,
+                                                      size_t max_n) const;
 
   RobotModel robot_;
   BaselineOptions opt_;

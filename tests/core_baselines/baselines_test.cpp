@@ -294,6 +294,33 @@ TEST(GoalDriver, WalksOntoAFrontierStillThereFromItsViewpoint) {
   }
 }
 
+// The ground under the robot unseen (a hole in the map where it stands): Stage 3 searches from
+// the nearest passable support around it instead of failing every goal (office seed 2 with
+// nearest-frontier stood still for 1600 s).
+TEST(GoalDriver, DrivesFromAStartWithNoGroundSeenUnderIt) {
+  World w;  // the corridor's floor with a 0.5 m hole where the robot stands
+  for (const auto& [lo, hi] : std::vector<std::pair<Eigen::Vector3f, Eigen::Vector3f>>{
+           {{-6, -1.5f, -0.2f}, {-0.25f, 1.5f, 0}},
+           {{0.25f, -1.5f, -0.2f}, {6, 1.5f, 0}},
+           {{-0.25f, -1.5f, -0.2f}, {0.25f, -0.25f, 0}},
+           {{-0.25f, 0.25f, -0.2f}, {0.25f, 1.5f, 0}}})
+    w.add(aabb(lo, hi));
+  w.add(aabb({-6, -1.7f, 0}, {6, -1.5f, 2.5f}));
+  w.add(aabb({-6, 1.5f, 0}, {6, 1.7f, 2.5f}));
+  map::TraversabilityMap m;
+  scan(m, w, {{-1, 0, 0.5f}, {2, 0, 0.5f}}, 6.0f);
+  const map::MapView view = m.view();
+  const plan::ExplorationInput in = input_at(view, {0, 0, 0});
+  GoalDriver d(RobotModel{}, plan::PlanOptions{}, 0.1, BaselineOptions{});
+  ASSERT_EQ(d.astar().plan(view, in.robot_foot_m, {1.5, 0, 0}).status,
+            plan::VoxelAStarStatus::kNoStartSupport);
+  Goal g;
+  g.p_m = g.key_m = {1.5, 0, 0};
+  plan::ExplorationResult r;
+  ASSERT_TRUE(d.drive(in, g, r));
+  EXPECT_LT((r.trajectory.sample(r.trajectory.t_end()).p_m - g.p_m).norm(), 0.2);
+}
+
 TEST(Baselines, BadInputFails) {
   plan::ExplorationInput in;
   NearestFrontierPlanner a(RobotModel{}, plan::PlanOptions{}, 0.1);
