@@ -112,7 +112,14 @@ bool GoalDriver::drive(const plan::ExplorationInput& in, const Goal& g,
   const auto free_start = plan::nearest_free_foot(
       checker_, *in.view, plan::BodyPose{in.robot_foot_m, in.robot_yaw_rad, 0.0, in.t_s}, 0.3);
   if (!free_start) return false;
-  const Eigen::Vector3d start = *free_start;
+  Eigen::Vector3d start = *free_start;
+  // As the local layer does (plan.brake_start): a moving robot's new trajectory starts where it
+  // comes to rest braking straight. From its foot at rest, the body overshot the new
+  // trajectory's start by up to 0.3 m and swung into maze walls (maze seed 1, nearest-frontier).
+  if (start == in.robot_foot_m)
+    if (const auto rest = plan::straight_rest_point(
+            checker_, *in.view, robot_, start, in.robot_yaw_rad, in.robot_velocity_mps, in.t_s))
+      start = *rest;
   std::vector<Eigen::Vector3d> path = g.path_m;
   if (path.empty() || start != in.robot_foot_m) {
     plan::VoxelPath vp = astar_.plan(*in.view, start, g.p_m);

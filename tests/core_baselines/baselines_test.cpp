@@ -321,6 +321,28 @@ TEST(GoalDriver, DrivesFromAStartWithNoGroundSeenUnderIt) {
   EXPECT_LT((r.trajectory.sample(r.trajectory.t_end()).p_m - g.p_m).norm(), 0.2);
 }
 
+// A moving robot's new trajectory starts where it comes to rest braking straight (as the local
+// layer's plan.brake_start), not at its foot: from there the body overshot the start and swung.
+TEST(GoalDriver, AMovingRobotsTrajectoryStartsWhereItComesToRest) {
+  const World w = corridor_along_x(6);
+  map::TraversabilityMap m;
+  scan(m, w, {{0, 0, 0.5f}, {3, 0, 0.5f}}, 6.0f);
+  const map::MapView view = m.view();
+  Goal g;
+  g.p_m = g.key_m = {3, 0, 0};
+  const RobotModel robot;
+  for (const double speed : {0.0, 0.8}) {
+    plan::ExplorationInput in = input_at(view, {0, 0, 0});
+    in.robot_velocity_mps = {speed, 0};
+    GoalDriver d(robot, plan::PlanOptions{}, 0.1, BaselineOptions{});
+    plan::ExplorationResult r;
+    ASSERT_TRUE(d.drive(in, g, r)) << speed;
+    const double rest = speed * speed / (2.0 * robot.max_accel_mps2);
+    const Eigen::Vector3d first = r.trajectory.sample(r.trajectory.t_start()).p_m;
+    EXPECT_NEAR(first.x(), rest, 0.06) << "at " << speed << " m/s";
+  }
+}
+
 TEST(Baselines, BadInputFails) {
   plan::ExplorationInput in;
   NearestFrontierPlanner a(RobotModel{}, plan::PlanOptions{}, 0.1);
