@@ -171,17 +171,19 @@ struct PlanOptions {
   // climb's end that fails along that climb's axis is tried up the axis the robot faces, found anew
   // (LocalPlanner::climb_on).
   bool climb_axis_anew = false;
-  // Beyond the paper, off in config/default.yaml (session 34): a frontier set aside unresolved
-  // (still a frontier with the robot at its viewpoint, or overdue) where one was set aside before
-  // waits twice as long (up to 16x) before a move away releases it. A hole by a wall end that the
-  // robot's blind ring covers from every viewpoint drew the robot back every 30 s for the maze's
-  // last 350 s (seed 1, ground floor 75.9 %; 94.1 % with it). Off: office seed 2's path with it
-  // went back onto the flight from its landing and wedged the body (docs/RESULTS.md).
+  // Beyond the paper, on in config/default.yaml since session 35 (added in 34): a frontier set
+  // aside unresolved (still a frontier with the robot at its viewpoint, or overdue) where one was
+  // set aside before waits twice as long (up to 16x) before a move away releases it. A hole by a
+  // wall end that the robot's blind ring covers from every viewpoint drew the robot back every
+  // 30 s for the maze's last 350 s (seed 1, ground floor 75.9 %; 94.1 % with it). Off in session
+  // 34: office seed 2's path with it went back onto the flight from its landing and wedged the
+  // body; on with no_views_on_climbed_flights, which keeps it off the flight (docs/RESULTS.md).
   bool set_aside_backoff = false;
-  // Beyond the paper (session 35): a cluster's viewpoints on a flight the robot climbed are not
-  // targets (its nodes there already are not, LocalPlanner::on_climbed_flight). Right after its
-  // climb office seed 2 (with set_aside_backoff) went back down to a viewpoint on the top tread,
-  // turned on the treads and wedged the body crossing the landing's edge diagonally.
+  // Beyond the paper, on in config/default.yaml (session 35): a cluster's viewpoints on a flight
+  // the robot climbed are not targets (its nodes there already are not,
+  // LocalPlanner::on_climbed_flight). Right after its climb office seed 2 (with
+  // set_aside_backoff) went back down to a viewpoint on the top tread, turned on the treads and
+  // wedged the body crossing the landing's edge diagonally.
   bool no_views_on_climbed_flights = false;
   bool incremental_maintenance = true;
 };
