@@ -99,6 +99,14 @@ int main(int argc, char** argv) {
                    "%s, into %s\n",
                    specs.size(), o.seeds.empty() ? 0 : specs.size() / o.seeds.size(),
                    o.seeds.size(), jobs, storey.c_str(), o.out_dir.c_str());
+      // Each run reads ./config/default.yaml when no --config is given: that file belongs to the
+      // working tree, which need not be the code another --storey was built from (session 35:
+      // a key added to the tree's file failed 43 runs of a binary built before it).
+      if (!o.storey.empty() && o.config.empty())
+        std::fprintf(stderr,
+                     "storey-eval: warning: --storey without --config: every run reads "
+                     "config/default.yaml from %s, which may not match that build\n",
+                     std::filesystem::current_path().c_str());
       struct sigaction sa {};
       sa.sa_handler = on_interrupt;
       sa.sa_flags = SA_RESETHAND;  // a second Ctrl-C kills storey-eval at once
