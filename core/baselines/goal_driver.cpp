@@ -190,6 +190,7 @@ std::vector<Eigen::Vector3d> GoalDriver::passable_supports_near(const map::MapVi
 
 void GoalDriver::adopt(const plan::ExplorationInput& in, const Goal& g,
                        const plan::ExplorationResult& r) {
+  ever_moved_ = true;
   has_target_ = true;
   target_ = g;
   planned_at_s_ = in.t_s;
@@ -202,9 +203,11 @@ void GoalDriver::choose(const plan::ExplorationInput& in, std::vector<Goal>& goa
   std::erase_if(goals, [&](const Goal& g) { return set_aside(g); });
   if (goals.empty()) {
     // Nothing to see yet because the reachable set has not reached the robot (start-up): the
-    // map is still growing, not exhausted.
+    // map is still growing, not exhausted. Only before the first trajectory: later, a robot
+    // stranded off the reachable set waited here for ever (house seed 3, nearest-frontier: 1773 s
+    // standing where it could neither turn nor escape).
     const auto s = in.view->support_surface_near(in.robot_foot_m.cast<float>(), 0.3);
-    if (!s || !s->reachable) {
+    if (!ever_moved_ && (!s || !s->reachable)) {
       r.status = plan::ExplorationStatus::kExploring;
       r.reason = "no reachable support at the robot yet";
       return;
@@ -233,6 +236,7 @@ void GoalDriver::choose(const plan::ExplorationInput& in, std::vector<Goal>& goa
     if (auto w = plan::escape_to_turn(checker_, *in.view, robot_, in.robot_foot_m, in.robot_yaw_rad,
                                       in.t_s, opt_.escape_turn_radius_m)) {
       has_target_ = false;
+      ever_moved_ = true;
       r.status = plan::ExplorationStatus::kNewTrajectory;
       r.trajectory = std::move(w->trajectory);
       r.real_until_s = r.trajectory.t_end();

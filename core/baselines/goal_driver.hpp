@@ -122,6 +122,7 @@ class GoalDriver {
   double planned_at_s_ = 0, traj_end_s_ = 0;
   plan::BsplineTrajectory traj_;  // the trajectory to the current target, re-checked in keep()
   bool approach_frontier_ = false;
+  bool ever_moved_ = false;                  // a trajectory was published (start-up is over)
   std::vector<Eigen::Vector3d> approached_;  // frontier keys walked onto (set_approach_frontier)
   std::vector<Eigen::Vector3d> set_aside_;
   SetAsideCounts counts_;

@@ -296,7 +296,7 @@ TEST(GoalDriver, WalksOntoAFrontierStillThereFromItsViewpoint) {
 
 // The ground under the robot unseen (a hole in the map where it stands): Stage 3 searches from
 // the nearest passable support around it instead of failing every goal (office seed 2 with
-// nearest-frontier stood still for 1600 s).
+// nearest-frontier stood still for 1600 s); and with nothing left to do there the run ends.
 TEST(GoalDriver, DrivesFromAStartWithNoGroundSeenUnderIt) {
   World w;  // the corridor's floor with a 0.5 m hole where the robot stands
   for (const auto& [lo, hi] : std::vector<std::pair<Eigen::Vector3f, Eigen::Vector3f>>{
@@ -319,6 +319,20 @@ TEST(GoalDriver, DrivesFromAStartWithNoGroundSeenUnderIt) {
   plan::ExplorationResult r;
   ASSERT_TRUE(d.drive(in, g, r));
   EXPECT_LT((r.trajectory.sample(r.trajectory.t_end()).p_m - g.p_m).norm(), 0.2);
+
+  // With no goal left, a robot off the reachable set waits only at start-up: once it has moved,
+  // that is the end (house seed 3, nearest-frontier, stood 1773 s waiting).
+  std::vector<Goal> none;
+  plan::ExplorationResult start_up;
+  d.choose(in, none, start_up);
+  EXPECT_EQ(start_up.status, plan::ExplorationStatus::kExploring) << start_up.reason;
+  std::vector<Goal> one{g};
+  plan::ExplorationResult moved;
+  d.choose(in, one, moved);
+  ASSERT_EQ(moved.status, plan::ExplorationStatus::kNewTrajectory) << moved.reason;
+  plan::ExplorationResult stranded;
+  d.choose(in, none, stranded);
+  EXPECT_EQ(stranded.status, plan::ExplorationStatus::kComplete) << stranded.reason;
 }
 
 // A moving robot's new trajectory starts where it comes to rest braking straight (as the local
