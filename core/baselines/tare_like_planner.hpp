@@ -45,6 +45,7 @@ class TareLikePlanner {
   plan::GraphSearch search_, path_search_;
   plan::SearchGraph sg_;
   uint32_t robot_node_ = UINT32_MAX;  // this cycle's robot node on sg_
+  std::vector<graph::NodeId> near_;   // scratch: nodes near the robot
   size_t kept_ = 0, refused_ = 0;
 };
 
