@@ -403,6 +403,7 @@ void Autonomy::plan_step() {
     s.goals_stood_at = int32_t(g->stood_at);
     s.goals_overdue = int32_t(g->overdue);
     s.goals_no_trajectory = int32_t(g->no_trajectory);
+    s.goals_no_progress = int32_t(g->no_progress);
   }
   s.trajectories = trajectories_;
   s.plan_cycles = plan_cycles_;

@@ -87,7 +87,7 @@ struct ExplorationStatus {
   uint32_t clusters_set_aside = 0, clusters_unreachable = 0;
   uint32_t robot_component_nodes = 0;  // nodes connected to the robot's through G_real
   // A baseline's own set-aside goals (GoalDriver::SetAsideCounts; all -1 for the storey method).
-  int32_t goals_stood_at = -1, goals_overdue = -1, goals_no_trajectory = -1;
+  int32_t goals_stood_at = -1, goals_overdue = -1, goals_no_trajectory = -1, goals_no_progress = -1;
   uint64_t trajectories = 0, plan_cycles = 0;
   int floor_hint = 0;  // round(robot z / floor_height_hint_m)
   // Macro layer (storey method; -1 / 0 for the baselines): the robot's floor and its reference

@@ -25,7 +25,8 @@ GoalDriver::GoalDriver(const RobotModel& robot, const plan::PlanOptions& plan, d
       opt_(options),
       astar_(plan::astar_options(plan)),
       builder_(robot, plan::trajectory_options(plan)),
-      checker_(robot, voxel_size_m) {}
+      checker_(robot, voxel_size_m),
+      no_progress_s_(plan.no_progress_s) {}
 
 bool GoalDriver::set_aside(const Eigen::Vector3d& key_m) const {
   for (const Eigen::Vector3d& s : set_aside_)
@@ -39,8 +40,57 @@ bool GoalDriver::set_aside(const Goal& g) const {
   return set_aside(g.key_m) || set_aside(g.p_m);
 }
 
+bool GoalDriver::no_progress(const plan::ExplorationInput& in) {
+  const bool moved = !progress_foot_m_.allFinite() ||
+                     (in.robot_foot_m - progress_foot_m_).norm() > 0.15 ||
+                     std::abs(std::remainder(in.robot_yaw_rad - progress_yaw_, 2.0 * M_PI)) > 0.3;
+  if (!has_target_ || moved || no_progress_s_ <= 0) {
+    progress_foot_m_ = in.robot_foot_m;
+    progress_yaw_ = in.robot_yaw_rad;
+    progress_t_s_ = in.t_s;
+    return false;
+  }
+  if (in.t_s - progress_t_s_ < no_progress_s_) return false;
+  progress_t_s_ = in.t_s;
+  return true;
+}
+
 bool GoalDriver::keep(const plan::ExplorationInput& in, const std::vector<Goal>& goals,
                       plan::ExplorationResult& r) {
+  // An escape walk runs to its end, as the local layer's does (committed): replaced by the next
+  // cycle's trajectory to a goal, it moved the body 0.1 m and the robot stayed wedged at a maze
+  // wall's end (maze seed 2, tare-like).
+  if (escaping_) {
+    if (in.t_s <= escape_end_s_ + 1.0 && dist_xy(in.robot_foot_m, escape_to_m_) > 0.05) {
+      r.status = plan::ExplorationStatus::kKeep;
+      r.reason = "escape walk";
+      r.target_m = escape_to_m_;
+      r.target_yaw_rad = in.robot_yaw_rad;
+      return true;
+    }
+    escaping_ = false;
+  }
+  // As the local layer does: a robot that stood still with a target for no_progress_s (a body
+  // wedged at a wall corner, replanning the same target every replan_period_s: maze seed 2,
+  // tare-like, from 600 s to the limit) sets the target aside and steps away from what it meets.
+  if (no_progress(in)) {
+    add_set_aside(target_.key_m), add_set_aside(target_.p_m);
+    ++counts_.no_progress;
+    has_target_ = false;
+    const Eigen::Vector3f hit =
+        plan::blocking_point(*in.view, robot_, in.robot_foot_m, in.robot_yaw_rad);
+    const Eigen::Vector3d start =
+        plan::nearest_free_foot(checker_, *in.view,
+                                plan::BodyPose{in.robot_foot_m, in.robot_yaw_rad, 0.0, in.t_s}, 0.3)
+            .value_or(in.robot_foot_m);
+    if (auto w = plan::escape_to_turn(checker_, *in.view, robot_, start, in.robot_yaw_rad, in.t_s,
+                                      opt_.escape_turn_radius_m, &hit)) {
+      publish_escape(std::move(*w), in, r);
+      r.reason = "escape: no progress, away from what the body meets";
+      return true;
+    }
+    return false;
+  }
   if (!has_target_) return false;
   bool still_goal = false;
   for (const Goal& g : goals) still_goal = still_goal || near(g.key_m, target_.key_m, 0.5);
@@ -188,6 +238,20 @@ std::vector<Eigen::Vector3d> GoalDriver::passable_supports_near(const map::MapVi
   return out;
 }
 
+void GoalDriver::publish_escape(plan::StraightWalk w, const plan::ExplorationInput& in,
+                                plan::ExplorationResult& r) {
+  has_target_ = false;
+  ever_moved_ = true;
+  escaping_ = true;
+  escape_end_s_ = w.trajectory.t_end();
+  escape_to_m_ = w.to_m;
+  r.status = plan::ExplorationStatus::kNewTrajectory;
+  r.trajectory = std::move(w.trajectory);
+  r.real_until_s = r.trajectory.t_end();
+  r.target_m = w.to_m;
+  r.target_yaw_rad = in.robot_yaw_rad;
+}
+
 void GoalDriver::adopt(const plan::ExplorationInput& in, const Goal& g,
                        const plan::ExplorationResult& r) {
   ever_moved_ = true;
@@ -235,13 +299,7 @@ void GoalDriver::choose(const plan::ExplorationInput& in, std::vector<Goal>& goa
   if (!failed.empty() && !plan::can_turn_at(checker_, *in.view, in.robot_foot_m, in.robot_yaw_rad))
     if (auto w = plan::escape_to_turn(checker_, *in.view, robot_, in.robot_foot_m, in.robot_yaw_rad,
                                       in.t_s, opt_.escape_turn_radius_m)) {
-      has_target_ = false;
-      ever_moved_ = true;
-      r.status = plan::ExplorationStatus::kNewTrajectory;
-      r.trajectory = std::move(w->trajectory);
-      r.real_until_s = r.trajectory.t_end();
-      r.target_m = w->to_m;
-      r.target_yaw_rad = in.robot_yaw_rad;
+      publish_escape(std::move(*w), in, r);
       r.reason = "escape: cannot turn here";
       return;
     }

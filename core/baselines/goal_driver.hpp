@@ -6,6 +6,7 @@
 // is reached, gone or due for a replan; set aside goals that stay frontiers after the robot
 // stood there or whose Stage 3 fails repeatedly (so exploration ends when nothing reachable
 // and observable is left). Single-threaded; owned by one baseline planner.
+#include <cmath>
 #include <functional>
 #include <optional>
 #include <vector>
@@ -14,6 +15,7 @@
 
 #include "core/plan/bspline_trajectory.hpp"
 #include "core/plan/collision_checker.hpp"
+#include "core/plan/escape.hpp"
 #include "core/plan/exploration_planner.hpp"
 #include "core/plan/plan_options.hpp"
 #include "core/plan/voxel_astar.hpp"
@@ -74,12 +76,16 @@ class GoalDriver {
 
   bool set_aside(const Eigen::Vector3d& key_m) const;
   bool set_aside(const Goal& g) const;  // its key or its standing point
-  void drop_target() { has_target_ = false; }
+  // Set aside the goals within set_aside_radius_m of p_m, as choose() does after max_failures
+  // (the planners' own goal filters see it at once).
+  void set_aside_at(const Eigen::Vector3d& p_m) { add_set_aside(p_m); }
+  void drop_target() { has_target_ = escaping_ = false; }
   bool has_target() const { return has_target_; }
   // Goals set aside, by why: stood there and still a goal / never arrived (overdue_s) / Stage 3
-  // failed max_failures times. The run record's end reason names them.
+  // failed max_failures times / the robot stood still with it for plan.no_progress_s. The run
+  // record's end reason names them.
   struct SetAsideCounts {
-    uint32_t stood_at = 0, overdue = 0, no_trajectory = 0;
+    uint32_t stood_at = 0, overdue = 0, no_trajectory = 0, no_progress = 0;
   };
   const SetAsideCounts& set_aside_counts() const { return counts_; }
   plan::VoxelAStar& astar() { return astar_; }
@@ -102,7 +108,14 @@ class GoalDriver {
 
  private:
   void add_set_aside(const Eigen::Vector3d& key_m) { set_aside_.push_back(key_m); }
+  // The local layer's no-progress watchdog (PlanOptions::no_progress_s): true once the robot
+  // stood still (0.15 m, 0.3 rad) that long with a target, replans to the same target included.
+  bool no_progress(const plan::ExplorationInput& in);
   void adopt(const plan::ExplorationInput& in, const Goal& g, const plan::ExplorationResult& r);
+  // r: the escape walk w as a new trajectory with no target kept (the goals are not blamed);
+  // keep() keeps it until it ends.
+  void publish_escape(plan::StraightWalk w, const plan::ExplorationInput& in,
+                      plan::ExplorationResult& r);
   // Up to max_n points within radius_m (horizontally) of p_m over support voxels the voxel A* may
   // stand on, nearest first, at least 0.25 m apart.
   std::vector<Eigen::Vector3d> passable_supports_near(const map::MapView& view,
@@ -122,6 +135,12 @@ class GoalDriver {
   double planned_at_s_ = 0, traj_end_s_ = 0;
   plan::BsplineTrajectory traj_;  // the trajectory to the current target, re-checked in keep()
   bool approach_frontier_ = false;
+  double no_progress_s_ = 0;  // PlanOptions::no_progress_s (0: off)
+  bool escaping_ = false;     // an escape walk (publish_escape) runs until it ends at escape_to_m_
+  double escape_end_s_ = 0;
+  Eigen::Vector3d escape_to_m_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d progress_foot_m_ = Eigen::Vector3d::Constant(NAN);
+  double progress_yaw_ = 0, progress_t_s_ = 0;
   bool ever_moved_ = false;                  // a trajectory was published (start-up is over)
   std::vector<Eigen::Vector3d> approached_;  // frontier keys walked onto (set_approach_frontier)
   std::vector<Eigen::Vector3d> set_aside_;

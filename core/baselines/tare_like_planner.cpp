@@ -169,9 +169,12 @@ std::vector<Goal> TareLikePlanner::goals(const plan::ExplorationInput& in) {
       Eigen::Vector3d look = fc.centroid_m.cast<double>() - goal.p_m;
       for (const graph::ClusterViewpoints& cv : *in.viewpoints) {
         if (cv.cluster_id != fc.id) continue;
+        // The first viewpoint not set aside (else the frontier node itself): the cluster's first
+        // viewpoint, set aside after its trajectories collided, made every later goal of the
+        // cluster a set-aside one and the run ended "complete" at 19.5 s (maze seed 5).
         for (const graph::Viewpoint& v : cv.viewpoints)
           if (v.node < g.node_capacity() && g.node(v.node).alive &&
-              std::isfinite(search_.dist(v.node))) {
+              std::isfinite(search_.dist(v.node)) && !driver_.set_aside(v.p_m.cast<double>())) {
             goal.p_m = v.p_m.cast<double>();
             goal.node = v.node;
             look = Eigen::Vector3d(std::cos(v.yaw_rad), std::sin(v.yaw_rad), 0);

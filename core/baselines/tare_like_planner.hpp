@@ -32,6 +32,7 @@ class TareLikePlanner {
   plan::ExplorationResult plan(const plan::ExplorationInput& in);
   void drop_target() { driver_.drop_target(); }
   const GoalDriver& driver() const { return driver_; }
+  GoalDriver& driver() { return driver_; }
   // Goals of one cycle: clusters of the first global subspace first, each by graph distance.
   std::vector<Goal> goals(const plan::ExplorationInput& in);
   // Number of graph edges the last cycle kept / refused by the height rule.

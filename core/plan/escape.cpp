@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <span>
 
 namespace storey::core::plan {
@@ -98,6 +99,25 @@ std::optional<StraightWalk> escape_to_turn(CollisionChecker& checker, const map:
       if (auto w = straight_walk(checker, view, robot, pts, yaw, t0)) return w;
     }
   return std::nullopt;
+}
+
+Eigen::Vector3f blocking_point(const map::MapView& view, const RobotModel& robot,
+                               const Eigen::Vector3d& foot, double yaw) {
+  const double vs = view.voxel_size_m();
+  Eigen::Vector3f best = Eigen::Vector3f::Zero();
+  double best_d = std::numeric_limits<double>::infinity();
+  for (double dx = -0.6; dx <= 0.6 + 1e-9; dx += vs)
+    for (double dy = -0.6; dy <= 0.6 + 1e-9; dy += vs)
+      for (double h = robot.step_height_m; h <= robot.body_height_m + 1e-9; h += vs) {
+        const double d = std::hypot(dx, dy);
+        if (d >= best_d) continue;
+        const Eigen::Vector3f q(float(foot.x() + dx), float(foot.y() + dy), float(foot.z() + h));
+        if (view.occupancy(q) == map::Occupancy::kOccupied) best = q, best_d = d;
+      }
+  if (std::isfinite(best_d)) return best;
+  return Eigen::Vector3f(float(foot.x() + 0.45 * std::cos(yaw)),
+                         float(foot.y() + 0.45 * std::sin(yaw)),
+                         float(foot.z() + 0.5 * robot.body_height_m));
 }
 
 std::optional<Eigen::Vector3d> nearest_free_foot(CollisionChecker& checker,

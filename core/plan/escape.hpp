@@ -57,6 +57,12 @@ std::optional<StraightWalk> escape_to_turn(CollisionChecker& checker, const map:
                                            double yaw, double t0, double radius_m,
                                            const Eigen::Vector3f* away_from = nullptr);
 
+// The occupied voxel nearest foot horizontally (within 0.6 m, from step height to body height
+// above it): what a body that stopped making progress is pressed against. None seen: a point
+// 0.45 m ahead at yaw, half the body's height up.
+Eigen::Vector3f blocking_point(const map::MapView& view, const RobotModel& robot,
+                               const Eigen::Vector3d& foot, double yaw);
+
 // The pose itself if the body there is collision-free, else the nearest collision-free one at the
 // same yaw within radius_m (0.05 m rings, 16 directions, height kept); nullopt: none.
 std::optional<Eigen::Vector3d> nearest_free_foot(CollisionChecker& checker,

@@ -627,26 +627,6 @@ bool LocalPlanner::floor_stale(const LocalPlanInput& in) {
   return plan_opt_.stale_floor_s > 0 && in.t_s - growth_mark_t_s_ >= plan_opt_.stale_floor_s;
 }
 
-Eigen::Vector3f LocalPlanner::blocking_point(const LocalPlanInput& in) const {
-  const map::MapView& view = *in.view;
-  const double vs = view.voxel_size_m();
-  const Eigen::Vector3d c = in.robot_foot_m;
-  Eigen::Vector3f best = kNoHitM;
-  double best_d = std::numeric_limits<double>::infinity();
-  for (double dx = -0.6; dx <= 0.6 + 1e-9; dx += vs)
-    for (double dy = -0.6; dy <= 0.6 + 1e-9; dy += vs)
-      for (double h = robot_.step_height_m; h <= robot_.body_height_m + 1e-9; h += vs) {
-        const double d = std::hypot(dx, dy);
-        if (d >= best_d) continue;
-        const Eigen::Vector3f q(float(c.x() + dx), float(c.y() + dy), float(c.z() + h));
-        if (view.occupancy(q) == map::Occupancy::kOccupied) best = q, best_d = d;
-      }
-  if (std::isfinite(best_d)) return best;
-  return Eigen::Vector3f(float(c.x() + 0.45 * std::cos(in.robot_yaw_rad)),
-                         float(c.y() + 0.45 * std::sin(in.robot_yaw_rad)),
-                         float(c.z() + 0.5 * robot_.body_height_m));
-}
-
 // A straight step to the nearest pose where the body can turn (escape.hpp), from the Stage 3
 // start; with away_from, one that gains distance from that point.
 bool LocalPlanner::escape(const LocalPlanInput& in, LocalPlanResult& out,
@@ -1261,7 +1241,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   bool stuck = false;
   if (no_progress(in)) {
     stuck = true;
-    const Eigen::Vector3f hit = blocking_point(in);
+    const Eigen::Vector3f hit = blocking_point(*in.view, robot_, in.robot_foot_m, in.robot_yaw_rad);
     if (const graph::FrontierCluster* tc = track_target(in); tc && !committed_)
       set_aside_cluster(in, *tc, SetAsideReason::kOverdue, hit);
     has_target_ = committed_ = flight_target_ = climb_start_ = false;

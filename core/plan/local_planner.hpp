@@ -281,9 +281,6 @@ class LocalPlanner {
   // PlanOptions::stale_floor_s: true once the graph has not grown for that long.
   bool floor_stale(const LocalPlanInput& in);
   void brake_start(const LocalPlanInput& in);  // PlanOptions::brake_start: moves start_foot_m_
-  // The nearest occupied voxel in the body's height band within 0.6 m of the robot, else the
-  // point 0.45 m ahead of it: what a body that does not move meets.
-  Eigen::Vector3f blocking_point(const LocalPlanInput& in) const;
   // away_from: the start is boxed in by this obstacle: move away from it even if the body can
   // turn where it stands.
   bool escape(const LocalPlanInput& in, LocalPlanResult& out,

@@ -1,13 +1,16 @@
 // The baselines of core/baselines/ on synthetic LiDAR worlds: behaviour that tells them apart.
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <memory>
+#include <string>
 
 #include "core/baselines/fael_like_planner.hpp"
 #include "core/baselines/nearest_frontier_planner.hpp"
 #include "core/baselines/tare_like_planner.hpp"
 #include "core/map/traversability_map.hpp"
 #include "tests/core_map/synthetic_world.hpp"
+#include "tests/core_plan_macro/macro_world.hpp"
 
 namespace storey::core::baselines {
 namespace {
@@ -183,6 +186,33 @@ TEST(TareLike, RefusesThePathUpAStairFlight) {
   EXPECT_TRUE(tare_path_ok(flat.points_m, 0.3, 1.0));
 }
 
+// A cluster whose first viewpoint was set aside (its trajectories collided near a wall) is still a
+// goal, from another place: the first viewpoint not set aside, else the frontier node itself.
+// Before, every later goal of the cluster stood at that viewpoint, was filtered out, and the run
+// ended "complete" at 19.5 s with 1 % of the maze seen (seed 5).
+TEST(TareLike, AClusterWhoseViewpointIsSetAsideKeepsAGoal) {
+  storey::test::macro::World w;  // a 3 m x 12 m corridor, its far end beyond the scan's range
+  w.add({-1, -1.5f, -0.2f}, {20, 1.5f, 0});
+  w.add({-1, -1.7f, 0}, {20, -1.5f, 2.5f});
+  w.add({-1, 1.5f, 0}, {20, 1.7f, 2.5f});
+  storey::test::macro::Harness h;
+  h.observe(w, {0, 0, 0}, 30000, 1);
+  const map::MapView view = h.map.view();
+  plan::ExplorationInput in = input_at(view, {0, 0, 0});
+  in.graph = &h.graph;
+  in.clusters = &h.clusters.clusters();
+  in.viewpoints = &h.viewpoints.viewpoints();
+  TareLikePlanner tare(RobotModel{}, plan::PlanOptions{}, 0.1);
+  const std::vector<Goal> first = tare.goals(in);
+  ASSERT_FALSE(first.empty());
+  for (int round = 0; round < 3; ++round) {
+    const std::vector<Goal> gs = tare.goals(in);
+    ASSERT_FALSE(gs.empty()) << "round " << round;
+    EXPECT_FALSE(tare.driver().set_aside(gs.front())) << "round " << round;
+    tare.driver().set_aside_at(gs.front().p_m);  // its trajectories failed
+  }
+}
+
 // GoalDriver's fallback path (tare-like: its own viewpoint graph) is taken only where the voxel
 // A* finds no path, and the trajectory then follows it.
 TEST(GoalDriver, FallbackPathOnlyWhereTheVoxelAStarFails) {
@@ -291,6 +321,48 @@ TEST(GoalDriver, WalksOntoAFrontierStillThereFromItsViewpoint) {
     EXPECT_FALSE(d.keep(on_it, goals, k2));
     EXPECT_TRUE(d.set_aside(g));
     EXPECT_EQ(d.set_aside_counts().stood_at, 1u);
+  }
+}
+
+// The local layer's no-progress watchdog (plan.no_progress_s): a robot that stands still with a
+// target, replanning to it every replan_period_s, sets it aside after no_progress_s and steps
+// away (tare-like stood wedged at a maze corner from 600 s to the limit, maze seed 2).
+TEST(GoalDriver, SetsAsideATargetItMakesNoProgressTo) {
+  const World w = corridor_along_x(6);
+  map::TraversabilityMap m;
+  scan(m, w, {{0, 0, 0.5f}, {3, 0, 0.5f}}, 6.0f);
+  const map::MapView view = m.view();
+  for (const double no_progress_s : {10.0, 0.0}) {
+    plan::PlanOptions po;
+    po.no_progress_s = no_progress_s;
+    GoalDriver d(RobotModel{}, po, 0.1, BaselineOptions{});
+    Goal g;
+    g.p_m = g.key_m = {3, 0, 0};
+    double fired_at = -1;
+    std::string after;                           // the reason of the cycle after it fired
+    for (double t = 1.0; t <= 14.0; t += 0.5) {  // the robot never moves
+      plan::ExplorationInput in = input_at(view, {0, 0, 0});
+      in.t_s = t;
+      std::vector<Goal> goals{g};
+      plan::ExplorationResult r;
+      if (!d.keep(in, goals, r)) d.choose(in, goals, r);
+      if (fired_at > 0 && after.empty()) after = r.reason;
+      if (r.reason && std::strstr(r.reason, "no progress") && fired_at < 0) {
+        fired_at = t;
+        EXPECT_EQ(r.status, plan::ExplorationStatus::kNewTrajectory) << r.reason;  // the escape
+      }
+    }
+    if (no_progress_s > 0) {
+      EXPECT_GE(fired_at, 11.0);  // 10 s after the first keep (1.5 s)
+      EXPECT_LE(fired_at, 12.0);
+      EXPECT_EQ(after, "escape walk");  // the escape runs to its end (the robot has not moved)
+      EXPECT_TRUE(d.set_aside(g));
+      EXPECT_EQ(d.set_aside_counts().no_progress, 1u);
+    } else {
+      EXPECT_LT(fired_at, 0);
+      EXPECT_FALSE(d.set_aside(g));
+      EXPECT_EQ(d.set_aside_counts().no_progress, 0u);
+    }
   }
 }
 

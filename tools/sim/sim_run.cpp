@@ -467,9 +467,9 @@ SimRunResult run_exploration(const SimRunOptions& opt) {
         else if (st.goals_stood_at >= 0)  // a baseline: its own goals, not the storey clusters
           std::snprintf(why, sizeof why,
                         "exploration complete at %.1f s: %s (%s: goals set aside: %d stood at, "
-                        "%d overdue, %d without a trajectory)",
+                        "%d overdue, %d without a trajectory, %d without progress)",
                         t, st.plan_reason, st.method, st.goals_stood_at, st.goals_overdue,
-                        st.goals_no_trajectory);
+                        st.goals_no_trajectory, st.goals_no_progress);
         else
           std::snprintf(why, sizeof why,
                         "exploration complete at %.1f s: %s (%u clusters, %u set aside as "
