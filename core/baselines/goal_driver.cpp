@@ -135,9 +135,7 @@ bool GoalDriver::keep(const plan::ExplorationInput& in, const std::vector<Goal>&
   // The map has grown since the trajectory was planned (a wall seen late, at a corner): re-check
   // what is left of it, on the plan-time check's sample grid as the local layer does, and replan
   // at once if it now collides rather than follow it until the periodic replan.
-  const double t_on =
-      in.t_s - std::clamp(in.trajectory_lag_s, 0.0, plan::LocalPlanner::kMaxReferenceLagS);
-  const double t_from = std::clamp(t_on, traj_.t_start(), traj_.t_end());
+  const double t_from = std::clamp(followed_s(in), traj_.t_start(), traj_.t_end());
   if (!traj_.empty() && checker_
                             .check_on_grid(
                                 *in.view, [&](double t) { return traj_.pose(t); }, traj_.t_start(),
@@ -153,6 +151,10 @@ bool GoalDriver::keep(const plan::ExplorationInput& in, const std::vector<Goal>&
   return true;
 }
 
+double GoalDriver::followed_s(const plan::ExplorationInput& in) {
+  return in.t_s - std::clamp(in.trajectory_lag_s, 0.0, plan::LocalPlanner::kMaxReferenceLagS);
+}
+
 bool GoalDriver::drive(const plan::ExplorationInput& in, const Goal& g,
                        plan::ExplorationResult& r) {
   // The body box with its margin may overlap an obstacle where the robot stands (tracking error,
@@ -163,13 +165,25 @@ bool GoalDriver::drive(const plan::ExplorationInput& in, const Goal& g,
       checker_, *in.view, plan::BodyPose{in.robot_foot_m, in.robot_yaw_rad, 0.0, in.t_s}, 0.3);
   if (!free_start) return false;
   Eigen::Vector3d start = *free_start;
+  double start_yaw = in.robot_yaw_rad;
   // As the local layer does (plan.brake_start): a moving robot's new trajectory starts where it
-  // comes to rest braking straight. From its foot at rest, the body overshot the new
-  // trajectory's start by up to 0.3 m and swung into maze walls (maze seed 1, nearest-frontier).
-  if (start == in.robot_foot_m)
-    if (const auto rest = plan::straight_rest_point(
-            checker_, *in.view, robot_, start, in.robot_yaw_rad, in.robot_velocity_mps, in.t_s))
-      start = *rest;
+  // comes to rest, braking along the trajectory it follows (the control task brakes on it before
+  // it enters a new one), else straight. From its foot at rest, the body overshot the new
+  // trajectory's start by up to 0.4 m and swung into maze walls (maze seed 1, nearest-frontier,
+  // straight; maze seed 2, tare-like, braking round a curve into a doorway).
+  if (start == in.robot_foot_m) {
+    const plan::RestOnTrajectory on =
+        plan::rest_on_trajectory(checker_, *in.view, robot_, traj_, start, in.robot_velocity_mps,
+                                 followed_s(in), in.t_s, false);
+    if (on.kind == plan::RestOnTrajectory::Kind::kRest) {
+      start = on.pose.foot_m;
+      start_yaw = on.pose.yaw_rad;
+    } else if (on.kind == plan::RestOnTrajectory::Kind::kNotOn) {
+      if (const auto rest = plan::straight_rest_point(
+              checker_, *in.view, robot_, start, in.robot_yaw_rad, in.robot_velocity_mps, in.t_s))
+        start = *rest;
+    }
+  }
   std::vector<Eigen::Vector3d> path = g.path_m;
   if (path.empty() || start != in.robot_foot_m) {
     plan::VoxelPath vp = astar_.plan(*in.view, start, g.p_m);
@@ -197,7 +211,7 @@ bool GoalDriver::drive(const plan::ExplorationInput& in, const Goal& g,
   plan::centre_path(*in.view, path);
   plan::align_before_climbs(*in.view, path);
   plan::TrajectoryResult tr =
-      builder_.build(*in.view, checker_, path, in.robot_yaw_rad, g.yaw_rad, in.t_s);
+      builder_.build(*in.view, checker_, path, start_yaw, g.yaw_rad, in.t_s);
   if (tr.status != plan::TrajectoryStatus::kOk && tr.status != plan::TrajectoryStatus::kPolyline)
     return false;
   r.status = plan::ExplorationStatus::kNewTrajectory;
@@ -245,6 +259,7 @@ void GoalDriver::publish_escape(plan::StraightWalk w, const plan::ExplorationInp
   escaping_ = true;
   escape_end_s_ = w.trajectory.t_end();
   escape_to_m_ = w.to_m;
+  traj_ = w.trajectory;  // followed now (a later start brakes along it)
   r.status = plan::ExplorationStatus::kNewTrajectory;
   r.trajectory = std::move(w.trajectory);
   r.real_until_s = r.trajectory.t_end();

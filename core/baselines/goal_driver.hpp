@@ -111,6 +111,8 @@ class GoalDriver {
   // The local layer's no-progress watchdog (PlanOptions::no_progress_s): true once the robot
   // stood still (0.15 m, 0.3 rad) that long with a target, replans to the same target included.
   bool no_progress(const plan::ExplorationInput& in);
+  // Where on the trajectory followed the control task's reference is (its clock, lag included).
+  static double followed_s(const plan::ExplorationInput& in);
   void adopt(const plan::ExplorationInput& in, const Goal& g, const plan::ExplorationResult& r);
   // r: the escape walk w as a new trajectory with no target kept (the goals are not blamed);
   // keep() keeps it until it ends.
@@ -133,7 +135,8 @@ class GoalDriver {
   bool has_target_ = false;
   Goal target_;
   double planned_at_s_ = 0, traj_end_s_ = 0;
-  plan::BsplineTrajectory traj_;  // the trajectory to the current target, re-checked in keep()
+  plan::BsplineTrajectory traj_;  // the trajectory last published (re-checked in keep() while it
+                                  // leads to the target; a new start brakes along it)
   bool approach_frontier_ = false;
   double no_progress_s_ = 0;  // PlanOptions::no_progress_s (0: off)
   bool escaping_ = false;     // an escape walk (publish_escape) runs until it ends at escape_to_m_

@@ -101,6 +101,51 @@ std::optional<StraightWalk> escape_to_turn(CollisionChecker& checker, const map:
   return std::nullopt;
 }
 
+RestOnTrajectory rest_on_trajectory(CollisionChecker& checker, const map::MapView& view,
+                                    const RobotModel& robot, const BsplineTrajectory& traj,
+                                    const Eigen::Vector3d& foot, const Eigen::Vector2d& v,
+                                    double t_on, double t_s, bool along_motion) {
+  using Kind = RestOnTrajectory::Kind;
+  RestOnTrajectory out;
+  const double d = v.squaredNorm() / (2.0 * std::max(robot.max_accel_mps2, 1e-3));
+  if (!std::isfinite(d) || d < 0.05 || traj.empty()) return out;
+  double s0 = NAN, best = 0.3;
+  for (double s = std::max(traj.t_start(), t_on - 2.0); s <= std::min(traj.t_end(), t_on + 2.0);
+       s += 0.02) {
+    const double e = (traj.sample(s).p_m - foot).head<2>().norm();
+    if (e < best) best = e, s0 = s;
+  }
+  if (!std::isfinite(s0)) return out;
+  std::vector<BodyPose> way;
+  double arc = 0, next = 0.05;
+  Eigen::Vector3d prev = traj.sample(s0).p_m;
+  for (double s = s0 + 0.02; s <= traj.t_end() + 1e-9 && arc < d; s += 0.02) {
+    const Eigen::Vector3d p = traj.sample(s).p_m;
+    arc += (p - prev).head<2>().norm();
+    prev = p;
+    if (arc >= next || arc >= d || s + 0.02 > traj.t_end()) {
+      BodyPose q = traj.pose(s);
+      q.t_s = t_s;
+      way.push_back(q);
+      next += 0.05;
+    }
+  }
+  // Only a trajectory the robot moves along: the one last published may be one the control
+  // task has not entered yet (it brakes on the one before), starting where that braking ends
+  // and heading back; a rest point predicted along it lay behind the robot (house seed 5,
+  // session 32: a new start 0.17 m beside where the body came to rest).
+  const Eigen::Vector2d to_rest =
+      way.empty() ? Eigen::Vector2d::Zero() : Eigen::Vector2d((way.back().foot_m - foot).head<2>());
+  if (along_motion && !(to_rest.dot(v) > 0.5 * to_rest.norm() * v.norm())) return out;
+  if (way.empty() || checker.check_poses(view, way).collides) {
+    out.kind = Kind::kBlocked;
+    return out;
+  }
+  out.kind = Kind::kRest;
+  out.pose = way.back();
+  return out;
+}
+
 Eigen::Vector3f blocking_point(const map::MapView& view, const RobotModel& robot,
                                const Eigen::Vector3d& foot, double yaw) {
   const double vs = view.voxel_size_m();

@@ -4,6 +4,7 @@
 // Stage-3 machinery shared by the paper's local layer (LocalPlanner) and the baselines
 // (GoalDriver): in a corridor narrower than the body's turning circle every path that starts
 // with a turn collides, however good the target.
+#include <cstdint>
 #include <optional>
 #include <vector>
 
@@ -48,6 +49,20 @@ std::optional<Eigen::Vector3d> straight_rest_point(CollisionChecker& checker,
                                                    const RobotModel& robot,
                                                    const Eigen::Vector3d& foot, double yaw,
                                                    const Eigen::Vector2d& v, double t_s);
+
+// Where a robot at foot moving at v comes to rest braking along traj, the trajectory it follows
+// (the control task brakes on it before it enters a new one): from traj's point nearest foot
+// (within 0.3 m, t_on +- 2 s), |v|^2 / (2 a_max) of arc on, its poses checked every 0.05 m.
+// kNotOn: under 0.05 m to rest, the robot not on traj, or (along_motion) the rest point not
+// ahead along v; kBlocked: a pose on the way collides (start where the robot is).
+struct RestOnTrajectory {
+  enum class Kind : uint8_t { kNotOn, kBlocked, kRest } kind = Kind::kNotOn;
+  BodyPose pose;  // kRest: the rest pose (at t_s)
+};
+RestOnTrajectory rest_on_trajectory(CollisionChecker& checker, const map::MapView& view,
+                                    const RobotModel& robot, const BsplineTrajectory& traj,
+                                    const Eigen::Vector3d& foot, const Eigen::Vector2d& v,
+                                    double t_on, double t_s, bool along_motion);
 
 // The straight step from start (yaw kept) to the nearest reachable pose within radius_m where
 // the body can turn, nearest first (0.1 m rings, 16 directions); with away_from, only poses that

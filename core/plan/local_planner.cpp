@@ -553,48 +553,14 @@ bool LocalPlanner::free_start(const LocalPlanInput& in) {
 // 0.6 rad either side), over no untraversable support.
 void LocalPlanner::brake_start(const LocalPlanInput& in) {
   const Eigen::Vector2d v = in.robot_velocity_mps;
-  const double d = v.squaredNorm() / (2.0 * std::max(robot_.max_accel_mps2, 1e-3));
-  if (!std::isfinite(d) || d < 0.05) return;
-  // On the trajectory followed: from its point nearest the robot (within 0.3 m), d of arc on.
-  if (!current_.empty()) {
-    double s0 = NAN, best = 0.3;
-    const double now = on_trajectory_s(in);
-    for (double s = std::max(current_.t_start(), now - 2.0);
-         s <= std::min(current_.t_end(), now + 2.0); s += 0.02) {
-      const double e = (current_.sample(s).p_m - in.robot_foot_m).head<2>().norm();
-      if (e < best) best = e, s0 = s;
-    }
-    if (std::isfinite(s0)) {
-      std::vector<BodyPose> way;
-      double arc = 0, next = 0.05;
-      Eigen::Vector3d prev = current_.sample(s0).p_m;
-      for (double s = s0 + 0.02; s <= current_.t_end() + 1e-9 && arc < d; s += 0.02) {
-        const Eigen::Vector3d p = current_.sample(s).p_m;
-        arc += (p - prev).head<2>().norm();
-        prev = p;
-        if (arc >= next || arc >= d || s + 0.02 > current_.t_end()) {
-          BodyPose q = current_.pose(s);
-          q.t_s = in.t_s;
-          way.push_back(q);
-          next += 0.05;
-        }
-      }
-      // Only a trajectory the robot moves along: the one last published may be one the control
-      // task has not entered yet (it brakes on the one before, plan.brake_start), starting where
-      // that braking ends and heading back; a rest point predicted along it lay behind the robot
-      // (house seed 5, session 32: a new start 0.17 m beside where the body came to rest).
-      const Eigen::Vector2d to_rest =
-          way.empty() ? Eigen::Vector2d::Zero()
-                      : Eigen::Vector2d((way.back().foot_m - in.robot_foot_m).head<2>());
-      const bool along =
-          !plan_opt_.brake_along_motion || to_rest.dot(v) > 0.5 * to_rest.norm() * v.norm();
-      if (along) {
-        if (way.empty() || checker_.check_poses(*in.view, way).collides) return;
-        start_foot_m_ = way.back().foot_m;
-        start_yaw_ = way.back().yaw_rad;
-        return;
-      }
-    }
+  const RestOnTrajectory on =
+      rest_on_trajectory(checker_, *in.view, robot_, current_, in.robot_foot_m, v,
+                         on_trajectory_s(in), in.t_s, plan_opt_.brake_along_motion);
+  if (on.kind == RestOnTrajectory::Kind::kBlocked) return;
+  if (on.kind == RestOnTrajectory::Kind::kRest) {
+    start_foot_m_ = on.pose.foot_m;
+    start_yaw_ = on.pose.yaw_rad;
+    return;
   }
   if (const auto rest = straight_rest_point(checker_, *in.view, robot_, in.robot_foot_m,
                                             in.robot_yaw_rad, v, in.t_s))

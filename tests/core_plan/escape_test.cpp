@@ -118,6 +118,46 @@ TEST(Escape, AMovingRobotComesToRestStraightAlongItsVelocity) {
   EXPECT_FALSE(straight_rest_point(checker, view, robot, {1.5, 0, 0}, 0.0, {0.2, 0.0}, 0.0));
 }
 
+// A robot on a curving trajectory comes to rest along that curve, not straight along its
+// velocity (the control task brakes on the trajectory it follows): GoalDriver and
+// LocalPlanner::brake_start start the next trajectory there. Off the trajectory: kNotOn.
+TEST(Escape, AMovingRobotComesToRestAlongTheCurveItFollows) {
+  const map::TraversabilityMap m = corridor_into_room();
+  const map::MapView view = m.view();
+  const RobotModel robot;
+  CollisionChecker checker(robot, view.voxel_size_m());
+  // A left turn in the room: east along y = -1, then north along x = 2.5.
+  std::vector<Eigen::Vector3d> ctrl;
+  for (double x = 0.5; x <= 2.01; x += 0.25) ctrl.push_back({x, -1.0, 0.0});
+  for (double y = -0.75; y <= 1.01; y += 0.25) ctrl.push_back({2.5, y, 0.0});
+  std::vector<double> yaw;
+  for (const Eigen::Vector3d& c : ctrl) yaw.push_back(c.y() > -1.0 ? M_PI / 2 : 0.0);
+  const BsplineTrajectory traj(ctrl, yaw, 0.25, 0.0);
+  // At the start of the turn, moving east at 1.2 m/s: 0.36 m to rest.
+  double t = 0;
+  while (traj.sample(t).p_m.x() < 2.0) t += 0.01;
+  const Eigen::Vector3d foot = traj.sample(t).p_m;
+  const Eigen::Vector2d v(1.2, 0.0);
+  const RestOnTrajectory on =
+      rest_on_trajectory(checker, view, robot, traj, foot, v, t, 0.0, false);
+  ASSERT_EQ(on.kind, RestOnTrajectory::Kind::kRest);
+  double off = 1e9;  // on the curve ...
+  for (double s = traj.t_start(); s <= traj.t_end(); s += 0.01)
+    off = std::min(off, (traj.sample(s).p_m - on.pose.foot_m).head<2>().norm());
+  EXPECT_LT(off, 0.02);
+  EXPECT_GT(on.pose.foot_m.y(), foot.y() + 0.05);  // ... round the turn: north of straight ahead
+  const auto straight = straight_rest_point(checker, view, robot, foot, 0.0, v, 0.0);
+  ASSERT_TRUE(straight.has_value());
+  EXPECT_GT((*straight - on.pose.foot_m).head<2>().norm(), 0.05);
+  // Not on the trajectory (1 m beside it), or all but at rest: kNotOn.
+  EXPECT_EQ(rest_on_trajectory(checker, view, robot, traj, foot + Eigen::Vector3d(0, 1, 0), v, t,
+                               0.0, false)
+                .kind,
+            RestOnTrajectory::Kind::kNotOn);
+  EXPECT_EQ(rest_on_trajectory(checker, view, robot, traj, foot, {0.2, 0.0}, t, 0.0, false).kind,
+            RestOnTrajectory::Kind::kNotOn);
+}
+
 TEST(Escape, NearestFreeFootStepsAwayFromAWallItOverlaps) {
   const map::TraversabilityMap m = corridor_into_room();
   const map::MapView view = m.view();
