@@ -40,21 +40,6 @@ bool GoalDriver::set_aside(const Goal& g) const {
   return set_aside(g.key_m) || set_aside(g.p_m);
 }
 
-bool GoalDriver::no_progress(const plan::ExplorationInput& in) {
-  const bool moved = !progress_foot_m_.allFinite() ||
-                     (in.robot_foot_m - progress_foot_m_).norm() > 0.15 ||
-                     std::abs(std::remainder(in.robot_yaw_rad - progress_yaw_, 2.0 * M_PI)) > 0.3;
-  if (!has_target_ || moved || no_progress_s_ <= 0) {
-    progress_foot_m_ = in.robot_foot_m;
-    progress_yaw_ = in.robot_yaw_rad;
-    progress_t_s_ = in.t_s;
-    return false;
-  }
-  if (in.t_s - progress_t_s_ < no_progress_s_) return false;
-  progress_t_s_ = in.t_s;
-  return true;
-}
-
 bool GoalDriver::keep(const plan::ExplorationInput& in, const std::vector<Goal>& goals,
                       plan::ExplorationResult& r) {
   // An escape walk runs to its end, as the local layer's does (committed): replaced by the next
@@ -73,7 +58,7 @@ bool GoalDriver::keep(const plan::ExplorationInput& in, const std::vector<Goal>&
   // As the local layer does: a robot that stood still with a target for no_progress_s (a body
   // wedged at a wall corner, replanning the same target every replan_period_s: maze seed 2,
   // tare-like, from 600 s to the limit) sets the target aside and steps away from what it meets.
-  if (no_progress(in)) {
+  if (progress_.stalled(in.robot_foot_m, in.robot_yaw_rad, in.t_s, has_target_, no_progress_s_)) {
     add_set_aside(target_.key_m), add_set_aside(target_.p_m);
     ++counts_.no_progress;
     has_target_ = false;

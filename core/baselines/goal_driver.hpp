@@ -108,9 +108,6 @@ class GoalDriver {
 
  private:
   void add_set_aside(const Eigen::Vector3d& key_m) { set_aside_.push_back(key_m); }
-  // The local layer's no-progress watchdog (PlanOptions::no_progress_s): true once the robot
-  // stood still (0.15 m, 0.3 rad) that long with a target, replans to the same target included.
-  bool no_progress(const plan::ExplorationInput& in);
   // Where on the trajectory followed the control task's reference is (its clock, lag included).
   static double followed_s(const plan::ExplorationInput& in);
   void adopt(const plan::ExplorationInput& in, const Goal& g, const plan::ExplorationResult& r);
@@ -142,8 +139,7 @@ class GoalDriver {
   bool escaping_ = false;     // an escape walk (publish_escape) runs until it ends at escape_to_m_
   double escape_end_s_ = 0;
   Eigen::Vector3d escape_to_m_ = Eigen::Vector3d::Zero();
-  Eigen::Vector3d progress_foot_m_ = Eigen::Vector3d::Constant(NAN);
-  double progress_yaw_ = 0, progress_t_s_ = 0;
+  plan::NoProgressWatchdog progress_;        // the local layer's no-progress watchdog
   bool ever_moved_ = false;                  // a trajectory was published (start-up is over)
   std::vector<Eigen::Vector3d> approached_;  // frontier keys walked onto (set_approach_frontier)
   std::vector<Eigen::Vector3d> set_aside_;

@@ -146,6 +146,21 @@ RestOnTrajectory rest_on_trajectory(CollisionChecker& checker, const map::MapVie
   return out;
 }
 
+bool NoProgressWatchdog::stalled(const Eigen::Vector3d& foot, double yaw, double t_s,
+                                 bool has_target, double period_s) {
+  const bool moved = !foot_m_.allFinite() || (foot - foot_m_).norm() > 0.15 ||
+                     std::abs(std::remainder(yaw - yaw_, 2.0 * M_PI)) > 0.3;
+  if (!has_target || moved || period_s <= 0) {
+    foot_m_ = foot;
+    yaw_ = yaw;
+    t_s_ = t_s;
+    return false;
+  }
+  if (t_s - t_s_ < period_s) return false;
+  t_s_ = t_s;
+  return true;
+}
+
 Eigen::Vector3f blocking_point(const map::MapView& view, const RobotModel& robot,
                                const Eigen::Vector3d& foot, double yaw) {
   const double vs = view.voxel_size_m();

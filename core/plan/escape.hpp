@@ -4,6 +4,7 @@
 // Stage-3 machinery shared by the paper's local layer (LocalPlanner) and the baselines
 // (GoalDriver): in a corridor narrower than the body's turning circle every path that starts
 // with a turn collides, however good the target.
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -71,6 +72,19 @@ std::optional<StraightWalk> escape_to_turn(CollisionChecker& checker, const map:
                                            const RobotModel& robot, const Eigen::Vector3d& start,
                                            double yaw, double t0, double radius_m,
                                            const Eigen::Vector3f* away_from = nullptr);
+
+// PlanOptions::no_progress_s, shared by LocalPlanner and GoalDriver: stalled() is true once the
+// robot stood still (within 0.15 m and 0.3 rad) for period_s with a target, replans to the same
+// target included; then the clock starts again. Off (never true) for period_s <= 0.
+class NoProgressWatchdog {
+ public:
+  bool stalled(const Eigen::Vector3d& foot, double yaw, double t_s, bool has_target,
+               double period_s);
+
+ private:
+  Eigen::Vector3d foot_m_ = Eigen::Vector3d::Constant(NAN);
+  double yaw_ = 0, t_s_ = 0;
+};
 
 // The occupied voxel nearest foot horizontally (within 0.6 m, from step height to body height
 // above it): what a body that stopped making progress is pressed against. None seen: a point

@@ -568,17 +568,9 @@ void LocalPlanner::brake_start(const LocalPlanInput& in) {
 }
 
 bool LocalPlanner::no_progress(const LocalPlanInput& in) {
-  const bool moved = !progress_foot_m_.allFinite() ||
-                     (in.robot_foot_m - progress_foot_m_).norm() > 0.15 ||
-                     std::abs(std::remainder(in.robot_yaw_rad - progress_yaw_, 2.0 * M_PI)) > 0.3;
-  if (!has_target_ || moved || plan_opt_.no_progress_s <= 0) {
-    progress_foot_m_ = in.robot_foot_m;
-    progress_yaw_ = in.robot_yaw_rad;
-    progress_t_s_ = in.t_s;
+  if (!progress_.stalled(in.robot_foot_m, in.robot_yaw_rad, in.t_s, has_target_,
+                         plan_opt_.no_progress_s))
     return false;
-  }
-  if (in.t_s - progress_t_s_ < plan_opt_.no_progress_s) return false;
-  progress_t_s_ = in.t_s;
   ++no_progress_events_;
   return true;
 }

@@ -408,8 +408,7 @@ class LocalPlanner {
   FlightAxis climb_axis_;     // climb_on's last axis (origin: the walk's foot on it)
   FlightAxis climbing_axis_;  // the committed climb's axis
   // No-progress watchdog: where and when the robot last moved (PlanOptions::no_progress_s).
-  Eigen::Vector3d progress_foot_m_ = Eigen::Vector3d::Constant(NAN);
-  double progress_yaw_ = 0, progress_t_s_ = 0;
+  NoProgressWatchdog progress_;
   uint64_t no_progress_events_ = 0;
   // PlanOptions::stale_floor_s: the graph's largest size and when it last grew past it.
   size_t growth_mark_nodes_ = 0;
