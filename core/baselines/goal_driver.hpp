@@ -32,6 +32,9 @@ struct BaselineOptions {
   double overdue_s = 10.0;            // trajectory ended this long ago without arrival: set aside
   double escape_turn_radius_m = 0.8;  // cannot turn on the spot: a turning place this far
                                       // (LocalPlannerOptions::escape_turn_radius_m)
+  double start_blame_radius_m = 0.7;  // every attempt's body hits an obstacle this close to the
+  int max_start_escapes = 3;          // start: step away from it, at most this many times in a row
+                                      // (LocalPlannerOptions, same names)
   int min_cluster_cells = 4;          // smaller frontier clusters are noise (nearest-frontier,
                                       // fael-like)
   double height_threshold_m = 0.3;    // tare-like: largest height difference of a link [m] ...
@@ -139,7 +142,10 @@ class GoalDriver {
   bool escaping_ = false;     // an escape walk (publish_escape) runs until it ends at escape_to_m_
   double escape_end_s_ = 0;
   Eigen::Vector3d escape_to_m_ = Eigen::Vector3d::Zero();
-  plan::NoProgressWatchdog progress_;        // the local layer's no-progress watchdog
+  plan::NoProgressWatchdog progress_;  // the local layer's no-progress watchdog
+  // Where drive()'s last Stage 3 attempt hit an obstacle (NaN: it did not collide).
+  Eigen::Vector3f last_hit_m_ = Eigen::Vector3f::Constant(NAN);
+  int start_escapes_ = 0;                    // boxed-in escapes since the last trajectory to a goal
   bool ever_moved_ = false;                  // a trajectory was published (start-up is over)
   std::vector<Eigen::Vector3d> approached_;  // frontier keys walked onto (set_approach_frontier)
   std::vector<Eigen::Vector3d> set_aside_;

@@ -429,6 +429,42 @@ TEST(GoalDriver, AMovingRobotsTrajectoryStartsWhereItComesToRest) {
   }
 }
 
+// Every attempt's body hits an obstacle next to the start: the start is to blame, not the goals.
+// The robot steps away from the nearest hit and the goals stay (maze seed 1, tare-like: counted
+// against the goals, every goal of the maze was set aside from one spot beside a wall's end).
+// Hits farther away blame the goals (set aside after max_failures cycles).
+TEST(GoalDriver, StepsAwayWhenEveryAttemptHitsNextToTheStart) {
+  for (const float pillar_x : {0.55f, 2.0f}) {
+    World w = corridor_along_x(6);
+    w.add(aabb({pillar_x, -0.5f, 0}, {pillar_x + 0.2f, 0.5f, 2.5f}));
+    map::TraversabilityMap m;
+    scan(m, w, {{0, 0, 0.5f}, {3, 0, 0.5f}}, 6.0f);
+    const map::MapView view = m.view();
+    GoalDriver d(RobotModel{}, plan::PlanOptions{}, 0.1, BaselineOptions{});
+    Goal g;
+    g.p_m = g.key_m = {3, 0, 0};
+    g.path_m = {{0, 0, 0}, {3, 0, 0}};  // straight through the pillar: every build collides
+    const bool near = pillar_x < 1.0f;
+    for (int cycle = 0; cycle < 2; ++cycle) {
+      plan::ExplorationInput in = input_at(view, {0, 0, 0});
+      in.t_s = 1.0 + cycle;
+      std::vector<Goal> goals{g};
+      plan::ExplorationResult r;
+      d.choose(in, goals, r);
+      if (near) {
+        ASSERT_EQ(r.status, plan::ExplorationStatus::kNewTrajectory) << r.reason;
+        EXPECT_STREQ(r.reason, "escape: boxed in by an obstacle next to the start");
+        EXPECT_LT(r.target_m.x(), -0.05);  // away from the pillar ahead
+        d.drop_target();
+      } else {
+        EXPECT_EQ(r.status, plan::ExplorationStatus::kExploring) << r.reason;
+      }
+    }
+    EXPECT_EQ(d.set_aside(g), !near) << pillar_x;
+    EXPECT_EQ(d.set_aside_counts().no_trajectory, near ? 0u : 1u);
+  }
+}
+
 TEST(Baselines, BadInputFails) {
   plan::ExplorationInput in;
   NearestFrontierPlanner a(RobotModel{}, plan::PlanOptions{}, 0.1);
