@@ -26,7 +26,8 @@ GoalDriver::GoalDriver(const RobotModel& robot, const plan::PlanOptions& plan, d
       astar_(plan::astar_options(plan)),
       builder_(robot, plan::trajectory_options(plan)),
       checker_(robot, voxel_size_m),
-      no_progress_s_(plan.no_progress_s) {}
+      no_progress_s_(plan.no_progress_s),
+      arrive_along_path_(plan.arrive_along_path) {}
 
 bool GoalDriver::set_aside(const Eigen::Vector3d& key_m) const {
   for (const Eigen::Vector3d& s : set_aside_)
@@ -198,15 +199,29 @@ bool GoalDriver::drive(const plan::ExplorationInput& in, const Goal& g,
   plan::align_before_climbs(*in.view, path);
   plan::TrajectoryResult tr =
       builder_.build(*in.view, checker_, path, start_yaw, g.yaw_rad, in.t_s);
-  if (tr.status != plan::TrajectoryStatus::kOk && tr.status != plan::TrajectoryStatus::kPolyline) {
+  auto failed = [&]() {
     if (tr.hit.collides) last_hit_m_ = tr.hit.voxel_m.cast<float>();
-    return false;
+    return tr.status != plan::TrajectoryStatus::kOk &&
+           tr.status != plan::TrajectoryStatus::kPolyline;
+  };
+  // As the local layer does (plan.arrive_along_path): the body hit something within a body length
+  // of the goal, turning to its heading: arrive facing along the path. tare-like's goals at the
+  // foot of the maze's 1.5 m wide ramp faced its side and were set aside, and the run ended
+  // "complete" below the ramp (maze seed 4, session 37).
+  double goal_yaw = g.yaw_rad;
+  if (failed()) {
+    if (!arrive_along_path_ || !tr.hit.collides ||
+        (tr.hit.voxel_m - g.p_m).head<2>().norm() > robot_.body_length_m)
+      return false;
+    tr = builder_.build(*in.view, checker_, path, start_yaw, std::nullopt, in.t_s);
+    if (failed()) return false;
+    goal_yaw = tr.trajectory.pose(tr.trajectory.t_end()).yaw_rad;
   }
   r.status = plan::ExplorationStatus::kNewTrajectory;
   r.trajectory = std::move(tr.trajectory);
   r.real_until_s = r.trajectory.t_end();  // baselines have no hypothetical space
   r.target_m = g.p_m;
-  r.target_yaw_rad = g.yaw_rad;
+  r.target_yaw_rad = goal_yaw;
   return true;
 }
 
@@ -260,6 +275,7 @@ void GoalDriver::adopt(const plan::ExplorationInput& in, const Goal& g,
   ever_moved_ = true;
   has_target_ = true;
   target_ = g;
+  target_.yaw_rad = r.target_yaw_rad;  // facing along the path where the goal heading collided
   planned_at_s_ = in.t_s;
   traj_end_s_ = r.trajectory.t_end();
   traj_ = r.trajectory;

@@ -138,8 +138,9 @@ class GoalDriver {
   plan::BsplineTrajectory traj_;  // the trajectory last published (re-checked in keep() while it
                                   // leads to the target; a new start brakes along it)
   bool approach_frontier_ = false;
-  double no_progress_s_ = 0;  // PlanOptions::no_progress_s (0: off)
-  bool escaping_ = false;     // an escape walk (publish_escape) runs until it ends at escape_to_m_
+  double no_progress_s_ = 0;        // PlanOptions::no_progress_s (0: off)
+  bool arrive_along_path_ = false;  // PlanOptions::arrive_along_path
+  bool escaping_ = false;  // an escape walk (publish_escape) runs until it ends at escape_to_m_
   double escape_end_s_ = 0;
   Eigen::Vector3d escape_to_m_ = Eigen::Vector3d::Zero();
   plan::NoProgressWatchdog progress_;  // the local layer's no-progress watchdog

@@ -1,6 +1,7 @@
 // The baselines of core/baselines/ on synthetic LiDAR worlds: behaviour that tells them apart.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
 #include <memory>
 #include <string>
@@ -462,6 +463,36 @@ TEST(GoalDriver, StepsAwayWhenEveryAttemptHitsNextToTheStart) {
     }
     EXPECT_EQ(d.set_aside(g), !near) << pillar_x;
     EXPECT_EQ(d.set_aside_counts().no_trajectory, near ? 0u : 1u);
+  }
+}
+
+// As the local layer's plan.arrive_along_path: a goal in a gate 0.7 m wide and 0.6 m long that
+// faces across it (the 0.8 m body box walks through the gate but cannot stand across it) is
+// reached facing along the path; off, Stage 3 fails (tare-like's goals at the foot of the maze's
+// ramp faced its side, were set aside, and the run ended below the ramp: maze seed 4).
+TEST(GoalDriver, AGoalTheBodyCannotTurnToIsReachedFacingAlongThePath) {
+  World w = corridor_along_x(6);
+  w.add(aabb({2.7f, -1.5f, 0}, {3.3f, -0.35f, 2.5f}));
+  w.add(aabb({2.7f, 0.35f, 0}, {3.3f, 1.5f, 2.5f}));
+  map::TraversabilityMap m;
+  scan(m, w, {{0, 0, 0.5f}, {4.5f, 0, 0.5f}}, 6.0f);
+  const map::MapView view = m.view();
+  Goal g;
+  g.p_m = g.key_m = {3, 0, 0};
+  g.yaw_rad = M_PI / 2;               // across the gate
+  g.path_m = {{0, 0, 0}, {3, 0, 0}};  // along the corridor's axis into the gate
+  for (const bool on : {true, false}) {
+    plan::PlanOptions po;
+    po.arrive_along_path = on;
+    GoalDriver d(RobotModel{}, po, 0.1, BaselineOptions{});
+    const plan::ExplorationInput in = input_at(view, {0, 0, 0});
+    plan::ExplorationResult r;
+    ASSERT_EQ(d.drive(in, g, r), on);
+    if (!on) continue;
+    const plan::BodyPose end = r.trajectory.pose(r.trajectory.t_end());
+    EXPECT_LT((end.foot_m - g.p_m).head<2>().norm(), 0.1);
+    EXPECT_LT(std::abs(std::remainder(end.yaw_rad, 2 * M_PI)), 0.2);  // along the corridor
+    EXPECT_NEAR(r.target_yaw_rad, end.yaw_rad, 1e-9);
   }
 }
 
