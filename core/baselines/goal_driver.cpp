@@ -63,19 +63,9 @@ bool GoalDriver::keep(const plan::ExplorationInput& in, const std::vector<Goal>&
     add_set_aside(target_.key_m), add_set_aside(target_.p_m);
     ++counts_.no_progress;
     has_target_ = false;
-    const Eigen::Vector3f hit =
-        plan::blocking_point(*in.view, robot_, in.robot_foot_m, in.robot_yaw_rad);
-    const Eigen::Vector3d start =
-        plan::nearest_free_foot(checker_, *in.view,
-                                plan::BodyPose{in.robot_foot_m, in.robot_yaw_rad, 0.0, in.t_s}, 0.3)
-            .value_or(in.robot_foot_m);
-    if (auto w = plan::escape_to_turn(checker_, *in.view, robot_, start, in.robot_yaw_rad, in.t_s,
-                                      opt_.escape_turn_radius_m, &hit)) {
-      publish_escape(std::move(*w), in, r);
-      r.reason = "escape: no progress, away from what the body meets";
-      return true;
-    }
-    return false;
+    return escape_away_from(
+        in, plan::blocking_point(*in.view, robot_, in.robot_foot_m, in.robot_yaw_rad),
+        "escape: no progress, away from what the body meets", r);
   }
   if (!has_target_) return false;
   bool still_goal = false;
@@ -255,6 +245,20 @@ std::vector<Eigen::Vector3d> GoalDriver::passable_supports_near(const map::MapVi
   return out;
 }
 
+bool GoalDriver::escape_away_from(const plan::ExplorationInput& in, const Eigen::Vector3f& hit,
+                                  const char* reason, plan::ExplorationResult& r) {
+  const Eigen::Vector3d start =
+      plan::nearest_free_foot(checker_, *in.view,
+                              plan::BodyPose{in.robot_foot_m, in.robot_yaw_rad, 0.0, in.t_s}, 0.3)
+          .value_or(in.robot_foot_m);
+  auto w = plan::escape_to_turn(checker_, *in.view, robot_, start, in.robot_yaw_rad, in.t_s,
+                                opt_.escape_turn_radius_m, &hit);
+  if (!w) return false;
+  publish_escape(std::move(*w), in, r);
+  r.reason = reason;
+  return true;
+}
+
 void GoalDriver::publish_escape(plan::StraightWalk w, const plan::ExplorationInput& in,
                                 plan::ExplorationResult& r) {
   has_target_ = false;
@@ -337,18 +341,10 @@ void GoalDriver::choose(const plan::ExplorationInput& in, std::vector<Goal>& goa
       r.reason = "escape: cannot turn here";
       return;
     }
-  if (!failed.empty() && boxed_in && start_escapes_ < opt_.max_start_escapes) {
-    const Eigen::Vector3d start =
-        plan::nearest_free_foot(checker_, *in.view,
-                                plan::BodyPose{in.robot_foot_m, in.robot_yaw_rad, 0.0, in.t_s}, 0.3)
-            .value_or(in.robot_foot_m);
-    if (auto w = plan::escape_to_turn(checker_, *in.view, robot_, start, in.robot_yaw_rad, in.t_s,
-                                      opt_.escape_turn_radius_m, &hit)) {
-      ++start_escapes_;
-      publish_escape(std::move(*w), in, r);
-      r.reason = "escape: boxed in by an obstacle next to the start";
-      return;
-    }
+  if (!failed.empty() && boxed_in && start_escapes_ < opt_.max_start_escapes &&
+      escape_away_from(in, hit, "escape: boxed in by an obstacle next to the start", r)) {
+    ++start_escapes_;
+    return;
   }
   for (const Goal* gp : failed) {
     const Goal& g = *gp;

@@ -118,6 +118,10 @@ class GoalDriver {
   // keep() keeps it until it ends.
   void publish_escape(plan::StraightWalk w, const plan::ExplorationInput& in,
                       plan::ExplorationResult& r);
+  // The escape walk (publish_escape) from the nearest free pose away from hit, with reason;
+  // false if there is none.
+  bool escape_away_from(const plan::ExplorationInput& in, const Eigen::Vector3f& hit,
+                        const char* reason, plan::ExplorationResult& r);
   // Up to max_n points within radius_m (horizontally) of p_m over support voxels the voxel A* may
   // stand on, nearest first, at least 0.25 m apart.
   std::vector<Eigen::Vector3d> passable_supports_near(const map::MapView& view,
