@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "core/plan/escape.hpp"
 #include "core/plan/local_planner.hpp"
@@ -312,7 +313,8 @@ void GoalDriver::choose(const plan::ExplorationInput& in, std::vector<Goal>& goa
   // Counted against the goals, every goal of the maze was set aside from one such spot and the
   // run ended "complete" at 782.5 s below the ramp (maze seed 1, tare-like, session 37).
   bool boxed_in = true;
-  Eigen::Vector3f hit = Eigen::Vector3f::Constant(NAN);
+  Eigen::Vector3f hit = Eigen::Vector3f::Constant(NAN);  // the hit nearest the start
+  double hit_d = std::numeric_limits<double>::infinity();
   for (const Goal& g : goals) {
     if (attempts++ >= opt_.max_attempts) break;
     if (drive(in, g, r)) {
@@ -322,14 +324,10 @@ void GoalDriver::choose(const plan::ExplorationInput& in, std::vector<Goal>& goa
       return;
     }
     failed.push_back(&g);
-    const bool near_start = last_hit_m_.allFinite() &&
-                            (last_hit_m_.cast<double>() - in.robot_foot_m).head<2>().norm() <=
-                                opt_.start_blame_radius_m;
-    boxed_in = boxed_in && near_start;
-    if (near_start &&
-        !(hit.allFinite() && dist_xy(hit.cast<double>(), in.robot_foot_m) <=
-                                 dist_xy(last_hit_m_.cast<double>(), in.robot_foot_m)))
-      hit = last_hit_m_;
+    const double d = last_hit_m_.allFinite() ? dist_xy(last_hit_m_.cast<double>(), in.robot_foot_m)
+                                             : std::numeric_limits<double>::infinity();
+    boxed_in = boxed_in && d <= opt_.start_blame_radius_m;
+    if (d < hit_d) hit_d = d, hit = last_hit_m_;
   }
   // As the local layer does: where the body cannot turn on the spot (a corridor narrower than
   // its turning circle) every path starting with a turn fails, whatever the goal; step straight
