@@ -30,6 +30,21 @@ bool tare_path_ok(const std::vector<Eigen::Vector3d>& path_m, double threshold_m
   return true;
 }
 
+uint32_t largest_part_start(const plan::SearchGraph& sg, std::span<const uint32_t> starts,
+                            plan::GraphSearch& search) {
+  uint32_t best = UINT32_MAX;
+  size_t best_size = 0;
+  std::vector<size_t> size(starts.size(), 0);  // 0: not measured yet
+  for (size_t i = 0; i < starts.size(); ++i) {
+    if (starts[i] >= sg.num_nodes() || size[i] != 0) continue;
+    const size_t n = search.dijkstra(sg, starts.subspan(i, 1)).size();
+    for (size_t j = i; j < starts.size(); ++j)  // the same part: measured with it
+      if (size[j] == 0 && std::isfinite(search.dist(starts[j]))) size[j] = n;
+    if (n > best_size) best_size = n, best = starts[i];
+  }
+  return best;
+}
+
 TareLikePlanner::TareLikePlanner(const RobotModel& robot, const plan::PlanOptions& plan,
                                  double voxel_size_m, const BaselineOptions& options)
     : opt_(options),
@@ -74,25 +89,31 @@ std::vector<Goal> TareLikePlanner::goals(const plan::ExplorationInput& in) {
   }
   sg_ = plan::SearchGraph::from_edges(pos, edges, true);
   robot_node_ = UINT32_MAX;
-  // The robot's node: the root if the height rule left it a link, else the nearest node within
-  // 1.5 m that has one (as the local layer searches from a linked node). A root with no link
-  // reached no cluster and the run ended "stranded" at 61 s, 27.9 % (office seed 4).
+  // The robot's node: among the root and the linked nodes within 1.5 m (nearest first), the one
+  // whose part of the viewpoint graph is largest. A root with no link reached no cluster and the
+  // run ended "stranded" at 61 s, 27.9 % (office seed 4); a root linked only to one other node,
+  // on top of the ramp, ended "stranded" at 444 s (maze seed 2).
   std::vector<uint8_t> linked(pos.size(), 0);
   for (const plan::SearchGraph::Edge& e : edges) linked[e.from] = linked[e.to] = 1;
-  uint32_t robot = g.root();
-  if (robot == graph::kNoId || !g.node(robot).alive || !linked[robot]) {
-    near_.clear();
-    g.nodes_within(in.robot_foot_m.cast<float>(), 1.5f, 1.0f, near_);
-    uint32_t best_n = graph::kNoId;
-    float best = std::numeric_limits<float>::infinity();
-    for (graph::NodeId n : near_) {
-      const float d = (g.node(n).p_m - in.robot_foot_m.cast<float>()).squaredNorm();
-      if (g.node(n).alive && linked[n] && d < best) best = d, best_n = n;
-    }
-    if (best_n != graph::kNoId)
-      robot = best_n;
-    else if (robot == graph::kNoId || !g.node(robot).alive)
-      robot = g.nearest(in.robot_foot_m.cast<float>(), 1.5f, 1.0f);
+  near_.clear();
+  g.nodes_within(in.robot_foot_m.cast<float>(), 1.5f, 1.0f, near_);
+  const Eigen::Vector3f foot = in.robot_foot_m.cast<float>();
+  std::sort(near_.begin(), near_.end(), [&](graph::NodeId a, graph::NodeId b) {
+    const float da = (g.node(a).p_m - foot).squaredNorm(),
+                db = (g.node(b).p_m - foot).squaredNorm();
+    return da < db || (da == db && a < b);
+  });
+  std::vector<uint32_t> starts;
+  const graph::NodeId root = g.root();
+  if (root != graph::kNoId && g.node(root).alive && linked[root]) starts.push_back(root);
+  for (graph::NodeId n : near_)
+    if (n != root && g.node(n).alive && linked[n]) starts.push_back(n);
+  uint32_t robot = largest_part_start(sg_, starts, search_);
+  if (robot == UINT32_MAX) {
+    if (root != graph::kNoId && g.node(root).alive)
+      robot = root;
+    else
+      robot = g.nearest(foot, 1.5f, 1.0f);
   }
   if (robot == graph::kNoId) return out;
   robot_node_ = robot;

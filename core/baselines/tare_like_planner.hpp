@@ -10,6 +10,7 @@
 // its best viewpoint is the goal. Stage 3 is the shared voxel A* + B-spline, with paths that
 // climb faster than the height rule rejected (then the filtered graph's own path is driven).
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "core/baselines/goal_driver.hpp"
@@ -24,6 +25,12 @@ bool tare_link_ok(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double thr
                   double spacing_m);
 // A support polyline obeys the rule between every pair of its points about spacing_m apart.
 bool tare_path_ok(const std::vector<Eigen::Vector3d>& path_m, double threshold_m, double spacing_m);
+
+// Of `starts` (in order of preference), the first whose connected part of `sg` is largest
+// (UINT32_MAX if none is a node of sg): where the robot stands between parts of its viewpoint
+// graph, it plans from the part that holds the map's work.
+uint32_t largest_part_start(const plan::SearchGraph& sg, std::span<const uint32_t> starts,
+                            plan::GraphSearch& search);
 
 class TareLikePlanner {
  public:

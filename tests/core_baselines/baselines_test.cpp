@@ -214,6 +214,25 @@ TEST(TareLike, AClusterWhoseViewpointIsSetAsideKeepsAGoal) {
   }
 }
 
+// Where the robot stands between parts of its viewpoint graph, it plans from the largest part:
+// a root linked only to one other node on top of the ramp reached no cluster, and the run ended
+// "stranded" at 444 s (maze seed 2).
+TEST(TareLike, PlansFromTheLargestPartOfItsGraphNearTheRobot) {
+  // Part A: nodes 0-1 (the root's). Part B: nodes 2-5. Node 6: alone.
+  std::vector<Eigen::Vector3d> pos;
+  for (int i = 0; i < 7; ++i) pos.emplace_back(i, 0, 0);
+  const std::vector<plan::SearchGraph::Edge> edges{
+      {0, 1, 1.0}, {2, 3, 1.0}, {3, 4, 1.0}, {4, 5, 1.0}};
+  const plan::SearchGraph sg = plan::SearchGraph::from_edges(pos, edges, true);
+  plan::GraphSearch search;
+  const std::vector<uint32_t> root_first{0, 1, 3, 2, 6};
+  EXPECT_EQ(largest_part_start(sg, root_first, search), 3u);  // the first of part B offered
+  const std::vector<uint32_t> equal{1, 6, 0};
+  EXPECT_EQ(largest_part_start(sg, equal, search), 1u);  // a tie keeps the preferred one
+  const std::vector<uint32_t> none{7, 99};
+  EXPECT_EQ(largest_part_start(sg, none, search), UINT32_MAX);
+}
+
 // GoalDriver's fallback path (tare-like: its own viewpoint graph) is taken only where the voxel
 // A* finds no path, and the trajectory then follows it.
 TEST(GoalDriver, FallbackPathOnlyWhereTheVoxelAStarFails) {
