@@ -151,6 +151,7 @@ void read_plan(SectionReader&& r, core::plan::PlanOptions& o) {
   r.get("lambda_psi", o.lambda_psi, kNonNegWeight);
   r.get("lambda_a", o.lambda_a, kNonNegWeight);
   r.get("guidance_zones", o.guidance_zones, Range{1, 100});
+  r.get("guidance_near_m", o.guidance_near_m, Range{0.0, 1000.0});
   r.get("floor_change_dz_m", o.floor_change_dz_m, Range{0.3, 10.0});
   r.get("hyp_discard_observations", o.hyp_discard_observations, Range{1, 1000});
   r.get("hyp_promote_radius_m", o.hyp_promote_radius_m, Range{0.01, 10.0});

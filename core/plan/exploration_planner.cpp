@@ -253,13 +253,23 @@ ExplorationResult ExplorationPlanner::plan_cycle(const ExplorationInput& in) {
           return std::find(gp.zone_order.begin(), gp.zone_order.begin() + long(first), zone) !=
                  gp.zone_order.begin() + long(first);
         };
+        // ... and those within guidance_near_m of the robot along G_real, so that a misleading
+        // sequence does not make the robot pass work on its way and come back for it.
+        if (opt_.guidance_near_m > 0)
+          near_search_.dijkstra(hybrid_.search_graph(), std::span<const uint32_t>(&robot_node, 1),
+                                opt_.guidance_near_m, [&](uint32_t e, uint32_t, uint32_t) {
+                                  return hybrid_.csr_edge_real(e);
+                                });
+        auto near = [&](uint32_t u) {
+          return opt_.guidance_near_m > 0 && std::isfinite(near_search_.dist(u));
+        };
         sel_clusters_.clear();
         sel_viewpoints_.clear();
         for (const graph::FrontierCluster& c : *in.clusters) {
           bool take = false;
           for (graph::NodeId n : c.nodes) {
             const uint32_t u = hybrid_.node_of_real(n);
-            take = take || (u != kNoNode && in_first(hybrid_.nodes()[u].zone));
+            take = take || (u != kNoNode && (in_first(hybrid_.nodes()[u].zone) || near(u)));
           }
           if (!take) continue;
           sel_clusters_.push_back(c);

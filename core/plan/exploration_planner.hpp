@@ -15,7 +15,8 @@
 // task zones (IV-A) and project them by dz into G_hyp; 3) hybrid-graph maintenance (IV-B);
 // 4) global guidance (IV-C) on the prior's target floor: TSP over uncompleted zones, the local
 // layer gets the TF clusters of the first guidance_zones zones of the sequence and the centre
-// of the next zone as terminal anchor c_anc; when those zones hold no cluster, the robot drives
+// of the next zone as terminal anchor c_anc (plus, if guidance_near_m > 0, every cluster within
+// that distance along G_real of the robot); when those zones hold no cluster, the robot drives
 // the real prefix of the two-stage path toward the first zone's centre (a zone whose real prefix
 // ends at the robot is set aside); 5) otherwise (first floor, no prior, ablation) the local
 // layer over all clusters; 6) completion: no reachable frontier and no uncompleted zone left.
@@ -133,6 +134,7 @@ class ExplorationPlanner {
   bool drove_ = false;  // this cycle published a drive
   std::vector<int32_t> set_aside_zones_;
   // Scratch.
+  GraphSearch near_search_;  // guidance_near_m: G_real around the robot
   std::vector<graph::FrontierCluster> sel_clusters_;
   std::vector<graph::ClusterViewpoints> sel_viewpoints_;
   std::vector<float> node_z_;
