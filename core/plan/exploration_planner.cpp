@@ -330,6 +330,10 @@ ExplorationResult ExplorationPlanner::plan_cycle(const ExplorationInput& in) {
       r.status = ExplorationStatus::kExploring;
       r.reason = "no collision-free start pose near the robot";
       return r;
+    case LocalPlanStatus::kSearching:  // bounded work: more to try next cycle, not "complete"
+      r.status = ExplorationStatus::kExploring;
+      r.reason = "targets left to try next cycle";
+      return r;
     case LocalPlanStatus::kBadInput:
       r.status = ExplorationStatus::kFailed;
       r.reason = "local planner rejected the input";

@@ -70,6 +70,7 @@ enum class LocalPlanStatus : uint8_t {
   kNoRobotNode,        // the robot has no node in G_real yet (map still growing)
   kStartBlocked,       // no collision-free pose near the robot to start a trajectory from
   kBadInput,
+  kSearching,  // targets left that this cycle's bounded work did not reach: try again next cycle
 };
 const char* to_string(LocalPlanStatus s);
 
@@ -138,6 +139,7 @@ struct LocalPlannerOptions {
   double set_aside_radius_m = 0.3;    // a frontier node this close to a set-aside one is ignored
   int max_failures = 2;               // Stage 3 failures before a cluster is set aside
   int max_stage3_attempts = 6;        // viewpoints tried per cycle (bounded work)
+  int max_off_graph_cycles = 20;      // cycles to_off_graph may take to try every viewpoint
   double escape_radius_m = 0.3;       // start pose in collision: free start searched this far
   double escape_turn_radius_m = 0.8;  // cannot turn on the spot: a turning place this far
   double start_blame_radius_m = 0.7;  // every try hits an obstacle this close to the start:
@@ -239,6 +241,15 @@ class LocalPlanner {
   std::vector<Viewpoint> viewpoints_of(const LocalPlanInput& in, const Candidate& c) const;
   // PlanOptions::reach_off_graph: clusters without a path along G_real tried on the map.
   bool to_off_graph(const LocalPlanInput& in, std::vector<Candidate>& off, LocalPlanResult& out);
+  // to_off_graph's progress across cycles: viewpoints of a cluster (by id, or its representative
+  // within 0.5 m) already tried, so that each cycle's bounded attempts take up the next ones.
+  struct OffGraphTried {
+    int32_t cluster_id;
+    Eigen::Vector3f rep_m;
+    size_t tried;
+  };
+  std::vector<OffGraphTried> off_graph_tried_;
+  int off_graph_cycles_ = 0;  // consecutive cycles that ended kSearching
   // Nothing else left: move to a new vantage point before the path failures end the run.
   bool retry_from_elsewhere(const LocalPlanInput& in, LocalPlanResult& out);
   void release_retry();

@@ -1513,6 +1513,59 @@ TEST(LocalPlanner, FrontiersWithNoPathAlongTheGraphAreReachedOnTheMapWithReachOf
   EXPECT_GT(on.end_x_m, 5.5);  // through the opening
 }
 
+// to_off_graph's attempts are bounded per cycle; the next cycle takes up the viewpoints after
+// those tried, and the search is not over (kSearching) until every one has been. Before, each
+// cycle tried the same first viewpoints of the first cluster, it was never set aside nor the
+// others tried, and the run ended "complete" with the office's upper floor at 87.3 % (seed 3).
+// Here the body is wider than the opening: no viewpoint beyond it is reached, 2 attempts a cycle.
+TEST(LocalPlanner, OffGraphViewpointsAreAllTriedOverCyclesBeforeTheSearchEnds) {
+  storey::core::graph::GraphOptions go;
+  go.keep_reachable_cut = true;
+  go.max_expansions_per_update = 1;
+  Harness h(go, 3);
+  World w = long_corridor();
+  for (float x : {0.f, 3.f, 7.f, 10.f})
+    h.observe(w, Eigen::Vector3f(x, 0, 0), 100000, 11 + uint32_t(x));
+  w.add({5.0f, -1.0f, 0.0f}, {5.2f, -0.4f, 2.5f});
+  w.add({5.0f, 0.4f, 0.0f}, {5.2f, 1.0f, 2.5f});
+  const Eigen::Vector3f foot(3.5f, 0, 0);
+  for (uint32_t r = 0; r < 3; ++r) h.observe(w, foot, 100000, 40 + r);
+  PlanOptions po;
+  po.reach_off_graph = true;
+  po.path_retries = false;
+  LocalPlannerOptions lo;
+  lo.max_stage3_attempts = 2;
+  RobotModel wide;
+  wide.body_width_m = 0.9;
+  LocalPlanner lp(wide, po, 0.1, lo);
+  const auto view = h.map.view();
+  std::vector<storey::core::graph::FrontierCluster> far;  // beyond the opening
+  for (const auto& c : h.clusters.clusters())
+    if (c.centroid_m.x() > 5.3f) far.push_back(c);
+  ASSERT_FALSE(far.empty());
+  LocalPlanInput in = input(h, view, foot, 0.0);
+  in.clusters = &far;
+  in.last_resort = true;
+  int searching = 0;
+  LocalPlanResult r;
+  for (int cycle = 0; cycle < 40; ++cycle) {
+    in.t_s = 0.5 * cycle;
+    r = lp.plan(in);
+    ASSERT_NE(r.status, LocalPlanStatus::kNewTrajectory) << r.replan_reason;
+    if (r.status != LocalPlanStatus::kSearching) break;
+    ++searching;
+  }
+  EXPECT_GT(searching, 0);
+  EXPECT_EQ(r.status, LocalPlanStatus::kNoReachableTarget);
+  // Every cluster beyond the opening was tried from each of its viewpoints and set aside (the
+  // counts are the cycle's start: one cycle more).
+  in.t_s += 0.5;
+  r = lp.plan(in);
+  EXPECT_EQ(r.status, LocalPlanStatus::kNoReachableTarget);
+  EXPECT_EQ(r.clusters_set_aside, int(far.size()));
+  EXPECT_EQ(r.clusters_unreachable, 0);
+}
+
 // The off-graph clusters are tried on the robot's level first (office seed 5, session 33: a
 // cluster on the floor below, nearest in 3D, spent every cycle's Stage 3 attempts), nearest
 // first within each level.
