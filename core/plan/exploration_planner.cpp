@@ -9,6 +9,29 @@
 
 namespace storey::core::plan {
 
+std::vector<uint8_t> guided_clusters(const HybridGraph& hg, std::span<const int32_t> first_zones,
+                                     uint32_t robot_node, double near_m,
+                                     const std::vector<graph::FrontierCluster>& clusters,
+                                     GraphSearch& search) {
+  // Within near_m along G_real (hypothetical edges excluded): the robot's neighbourhood as seen.
+  if (near_m > 0)
+    search.dijkstra(hg.search_graph(), std::span<const uint32_t>(&robot_node, 1), near_m,
+                    [&](uint32_t e, uint32_t, uint32_t) { return hg.csr_edge_real(e); });
+  std::vector<uint8_t> take(clusters.size(), 0);
+  for (size_t ci = 0; ci < clusters.size(); ++ci)
+    for (graph::NodeId n : clusters[ci].nodes) {
+      const uint32_t u = hg.node_of_real(n);
+      if (u == kNoNode) continue;
+      const bool first = std::find(first_zones.begin(), first_zones.end(), hg.nodes()[u].zone) !=
+                         first_zones.end();
+      if (first || (near_m > 0 && std::isfinite(search.dist(u)))) {
+        take[ci] = 1;
+        break;
+      }
+    }
+  return take;
+}
+
 namespace {
 // The local layer produced (or kept) a trajectory: it becomes the planner's result.
 void take_trajectory(LocalPlanResult& lr, ExplorationResult& r) {
@@ -249,29 +272,14 @@ ExplorationResult ExplorationPlanner::plan_cycle(const ExplorationInput& in) {
         // Clusters of the first guidance_zones zones; anchor = centre of the next zone.
         const size_t first =
             std::min(gp.zone_order.size(), size_t(std::max(1, opt_.guidance_zones)));
-        auto in_first = [&](int32_t zone) {
-          return std::find(gp.zone_order.begin(), gp.zone_order.begin() + long(first), zone) !=
-                 gp.zone_order.begin() + long(first);
-        };
-        // ... and those within guidance_near_m of the robot along G_real, so that a misleading
-        // sequence does not make the robot pass work on its way and come back for it.
-        if (opt_.guidance_near_m > 0)
-          near_search_.dijkstra(hybrid_.search_graph(), std::span<const uint32_t>(&robot_node, 1),
-                                opt_.guidance_near_m, [&](uint32_t e, uint32_t, uint32_t) {
-                                  return hybrid_.csr_edge_real(e);
-                                });
-        auto near = [&](uint32_t u) {
-          return opt_.guidance_near_m > 0 && std::isfinite(near_search_.dist(u));
-        };
         sel_clusters_.clear();
         sel_viewpoints_.clear();
-        for (const graph::FrontierCluster& c : *in.clusters) {
-          bool take = false;
-          for (graph::NodeId n : c.nodes) {
-            const uint32_t u = hybrid_.node_of_real(n);
-            take = take || (u != kNoNode && (in_first(hybrid_.nodes()[u].zone) || near(u)));
-          }
-          if (!take) continue;
+        const std::vector<uint8_t> take =
+            guided_clusters(hybrid_, std::span<const int32_t>(gp.zone_order.data(), first),
+                            robot_node, opt_.guidance_near_m, *in.clusters, near_search_);
+        for (size_t ci = 0; ci < in.clusters->size(); ++ci) {
+          if (!take[ci]) continue;
+          const graph::FrontierCluster& c = (*in.clusters)[ci];
           sel_clusters_.push_back(c);
           for (const graph::ClusterViewpoints& v : *in.viewpoints)
             if (v.cluster_id == c.id) sel_viewpoints_.push_back(v);

@@ -22,6 +22,7 @@
 // layer over all clusters; 6) completion: no reachable frontier and no uncompleted zone left.
 // Deterministic; single-threaded (the plan task owns it). Inputs must stay valid during plan().
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -52,6 +53,14 @@ struct ExplorationInput {
   // hyp_check_radius_m is re-checked on each new map version (correct, slower).
   const std::vector<graph::Aabb>* changed_regions = nullptr;
 };
+
+// Guidance (Sec. IV-C): which clusters the local layer serves (1 per cluster). Those with a node in
+// one of first_zones, and (near_m > 0) those with a node within near_m of robot_node along
+// G_real: PlanOptions::guidance_zones, guidance_near_m. robot_node is a node of hg.
+std::vector<uint8_t> guided_clusters(const HybridGraph& hg, std::span<const int32_t> first_zones,
+                                     uint32_t robot_node, double near_m,
+                                     const std::vector<graph::FrontierCluster>& clusters,
+                                     GraphSearch& search);
 
 enum class ExplorationStatus : uint8_t {
   kNewTrajectory = 0,  // publish `trajectory`

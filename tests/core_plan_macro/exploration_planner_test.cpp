@@ -189,3 +189,53 @@ TEST(GlobalPlanner, VisitsTheNearerHypotheticalZoneFirst) {
   GlobalPlanner all(TspOptions{}, 100);
   EXPECT_EQ(all.plan(hg, robot, [](int32_t) { return false; }).zone_order, plan.zone_order);
 }
+
+// Guidance's clusters (Sec. IV-C): those of the first zones of the sequence, and with
+// guidance_near_m those within that distance of the robot along G_real, whatever their zone.
+TEST(ExplorationPlanner, GuidanceServesTheFirstZonesAndWithGuidanceNearTheRobotsNeighbourhood) {
+  ToyGraph t;  // the prior: one room, the target floor's room as observed
+  t.add_room({0, 0, 6, 5}, 0.8, 0);
+  const SearchGraph g = t.csr();
+  TaskZonePartitioner part;
+  const ZonePartition zones = part.partition(g, t.clearance, {5.0, 4});
+  World w;
+  w.add({-1, -1, -0.2f}, {6, 6, 0});
+  Harness h;
+  const Eigen::Vector3f foot(2, 2.5f, 0);
+  h.observe(w, foot, 20000, 5);
+  FloorTracker ft;
+  ft.update(Eigen::Vector3d::Zero(), 0.0);
+  HybridGraph hg;
+  hg.init_prior(g, zones, 0.0, 0);
+  hg.update(h.map.view(), h.map.version(), h.graph, ft, foot.cast<double>(), PlanOptions{});
+  const uint32_t robot = hg.node_of_real(h.graph.root());
+  ASSERT_NE(robot, kNoNode);
+  // Two one-node clusters: one within 1.5 m of the robot along G_real, one beyond 4 m.
+  GraphSearch search;
+  search.dijkstra(hg.search_graph(), std::span<const uint32_t>(&robot, 1), kUnreachable,
+                  [&](uint32_t e, uint32_t, uint32_t) { return hg.csr_edge_real(e); });
+  storey::core::graph::NodeId near_n = storey::core::graph::kNoId,
+                              far_n = storey::core::graph::kNoId;
+  for (storey::core::graph::NodeId n = 0; n < h.graph.node_capacity(); ++n) {
+    if (!h.graph.node(n).alive) continue;
+    const uint32_t u = hg.node_of_real(n);
+    if (u == kNoNode) continue;
+    const double d = search.dist(u);
+    if (d > 0.5 && d < 1.5 && near_n == storey::core::graph::kNoId) near_n = n;
+    if (std::isfinite(d) && d > 4.0 && far_n == storey::core::graph::kNoId) far_n = n;
+  }
+  ASSERT_NE(near_n, storey::core::graph::kNoId);
+  ASSERT_NE(far_n, storey::core::graph::kNoId);
+  std::vector<storey::core::graph::FrontierCluster> clusters(2);
+  clusters[0].id = 1, clusters[0].nodes = {near_n};
+  clusters[1].id = 2, clusters[1].nodes = {far_n};
+  const std::vector<int32_t> no_zone;
+  EXPECT_EQ(guided_clusters(hg, no_zone, robot, 0.0, clusters, search),
+            (std::vector<uint8_t>{0, 0}));
+  EXPECT_EQ(guided_clusters(hg, no_zone, robot, 3.0, clusters, search),
+            (std::vector<uint8_t>{1, 0}));
+  const std::vector<int32_t> far_zone{hg.nodes()[hg.node_of_real(far_n)].zone};
+  const std::vector<uint8_t> with_zone =
+      guided_clusters(hg, far_zone, robot, 0.0, clusters, search);
+  EXPECT_EQ(with_zone[1], 1);
+}
