@@ -35,6 +35,23 @@ ExplorationInput input(const Harness& h, const storey::core::map::MapView& view,
   return in;
 }
 
+// The prior `t` (task zones of r_z 5 m) on floor 0, of which only room A (0-6 x 0-5 m) is
+// observed, from (2, 2.5): hg's first cycle. Returns the robot's node in hg.
+uint32_t prior_over_room_a(const ToyGraph& t, Harness& h, HybridGraph& hg) {
+  const SearchGraph g = t.csr();
+  TaskZonePartitioner part;
+  const ZonePartition zones = part.partition(g, t.clearance, {5.0, 4});
+  World w;
+  w.add({-1, -1, -0.2f}, {6, 6, 0});
+  const Eigen::Vector3f foot(2, 2.5f, 0);
+  h.observe(w, foot, 20000, 5);
+  FloorTracker ft;
+  ft.update(Eigen::Vector3d::Zero(), 0.0);
+  hg.init_prior(g, zones, 0.0, 0);
+  hg.update(h.map.view(), h.map.version(), h.graph, ft, foot.cast<double>(), PlanOptions{});
+  return hg.node_of_real(h.graph.root());
+}
+
 }  // namespace
 
 TEST(ExplorationPlanner, FloorChangeBuildsThePriorOnlyWithUsePrior) {
@@ -128,21 +145,9 @@ TEST(GlobalPlanner, VisitsTheNearerHypotheticalZoneFirst) {
   t.add_room({12.2, 0, 18, 5}, 0.8, 2);
   t.link(t.nearest({5.6, 2.4, 0}), t.nearest({6.6, 2.4, 0}));
   t.link(t.nearest({11.8, 2.4, 0}), t.nearest({12.6, 2.4, 0}));
-  const SearchGraph g = t.csr();
-  TaskZonePartitioner part;
-  const ZonePartition zones = part.partition(g, t.clearance, {5.0, 4});
-  World w;
-  w.add({-1, -1, -0.2f}, {6, 6, 0});
   Harness h;
-  const Eigen::Vector3f foot(2, 2.5f, 0);
-  h.observe(w, foot, 20000, 5);
-  FloorTracker ft;
-  ft.update(Eigen::Vector3d::Zero(), 0.0);
   HybridGraph hg;
-  hg.init_prior(g, zones, 0.0, 0);
-  PlanOptions opt;
-  hg.update(h.map.view(), h.map.version(), h.graph, ft, foot.cast<double>(), opt);
-  const uint32_t robot = hg.node_of_real(h.graph.root());
+  const uint32_t robot = prior_over_room_a(t, h, hg);
   ASSERT_NE(robot, kNoNode);
   GlobalPlanner gp;
   const GlobalPlan plan = gp.plan(hg, robot, [](int32_t) { return false; });
@@ -195,20 +200,9 @@ TEST(GlobalPlanner, VisitsTheNearerHypotheticalZoneFirst) {
 TEST(ExplorationPlanner, GuidanceServesTheFirstZonesAndWithGuidanceNearTheRobotsNeighbourhood) {
   ToyGraph t;  // the prior: one room, the target floor's room as observed
   t.add_room({0, 0, 6, 5}, 0.8, 0);
-  const SearchGraph g = t.csr();
-  TaskZonePartitioner part;
-  const ZonePartition zones = part.partition(g, t.clearance, {5.0, 4});
-  World w;
-  w.add({-1, -1, -0.2f}, {6, 6, 0});
   Harness h;
-  const Eigen::Vector3f foot(2, 2.5f, 0);
-  h.observe(w, foot, 20000, 5);
-  FloorTracker ft;
-  ft.update(Eigen::Vector3d::Zero(), 0.0);
   HybridGraph hg;
-  hg.init_prior(g, zones, 0.0, 0);
-  hg.update(h.map.view(), h.map.version(), h.graph, ft, foot.cast<double>(), PlanOptions{});
-  const uint32_t robot = hg.node_of_real(h.graph.root());
+  const uint32_t robot = prior_over_room_a(t, h, hg);
   ASSERT_NE(robot, kNoNode);
   // Two one-node clusters: one within 1.5 m of the robot along G_real, one beyond 4 m.
   GraphSearch search;

@@ -1458,6 +1458,26 @@ World long_corridor() {
   return w;
 }
 
+storey::core::graph::GraphOptions cut_graph_options() {
+  storey::core::graph::GraphOptions go;
+  go.keep_reachable_cut = true;
+  go.max_expansions_per_update = 1;
+  return go;
+}
+
+// The corridor observed over its length, then narrowed to the opening and observed from the
+// robot's foot (returned), short of it.
+Eigen::Vector3f observe_cut_corridor(Harness& h) {
+  World w = long_corridor();
+  for (float x : {0.f, 3.f, 7.f, 10.f})
+    h.observe(w, Eigen::Vector3f(x, 0, 0), 100000, 11 + uint32_t(x));
+  w.add({5.0f, -1.0f, 0.0f}, {5.2f, -0.4f, 2.5f});
+  w.add({5.0f, 0.4f, 0.0f}, {5.2f, 1.0f, 2.5f});
+  const Eigen::Vector3f foot(3.5f, 0, 0);
+  for (uint32_t r = 0; r < 3; ++r) h.observe(w, foot, 100000, 40 + r);
+  return foot;
+}
+
 struct OffGraphRun {
   LocalPlanStatus status = LocalPlanStatus::kBadInput;
   std::string reason;
@@ -1467,17 +1487,8 @@ struct OffGraphRun {
 };
 
 OffGraphRun run_off_graph(bool on) {
-  storey::core::graph::GraphOptions go;
-  go.keep_reachable_cut = true;
-  go.max_expansions_per_update = 1;
-  Harness h(go, 3);
-  World w = long_corridor();
-  for (float x : {0.f, 3.f, 7.f, 10.f})
-    h.observe(w, Eigen::Vector3f(x, 0, 0), 100000, 11 + uint32_t(x));
-  w.add({5.0f, -1.0f, 0.0f}, {5.2f, -0.4f, 2.5f});
-  w.add({5.0f, 0.4f, 0.0f}, {5.2f, 1.0f, 2.5f});
-  const Eigen::Vector3f foot(3.5f, 0, 0);
-  for (uint32_t r = 0; r < 3; ++r) h.observe(w, foot, 100000, 40 + r);
+  Harness h(cut_graph_options(), 3);
+  const Eigen::Vector3f foot = observe_cut_corridor(h);
   PlanOptions po;
   po.reach_off_graph = on;
   LocalPlanner lp(RobotModel{}, po, 0.1);
@@ -1519,17 +1530,8 @@ TEST(LocalPlanner, FrontiersWithNoPathAlongTheGraphAreReachedOnTheMapWithReachOf
 // others tried, and the run ended "complete" with the office's upper floor at 87.3 % (seed 3).
 // Here the body is wider than the opening: no viewpoint beyond it is reached, 2 attempts a cycle.
 TEST(LocalPlanner, OffGraphViewpointsAreAllTriedOverCyclesBeforeTheSearchEnds) {
-  storey::core::graph::GraphOptions go;
-  go.keep_reachable_cut = true;
-  go.max_expansions_per_update = 1;
-  Harness h(go, 3);
-  World w = long_corridor();
-  for (float x : {0.f, 3.f, 7.f, 10.f})
-    h.observe(w, Eigen::Vector3f(x, 0, 0), 100000, 11 + uint32_t(x));
-  w.add({5.0f, -1.0f, 0.0f}, {5.2f, -0.4f, 2.5f});
-  w.add({5.0f, 0.4f, 0.0f}, {5.2f, 1.0f, 2.5f});
-  const Eigen::Vector3f foot(3.5f, 0, 0);
-  for (uint32_t r = 0; r < 3; ++r) h.observe(w, foot, 100000, 40 + r);
+  Harness h(cut_graph_options(), 3);
+  const Eigen::Vector3f foot = observe_cut_corridor(h);
   PlanOptions po;
   po.reach_off_graph = true;
   po.path_retries = false;
