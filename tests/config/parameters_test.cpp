@@ -452,7 +452,7 @@ TEST(ConfigSchema, CoreOptionStructsAreFullyMapped) {
   EXPECT_EQ(sizeof(core::map::MapOptions), 152u) << "MapOptions changed: update the config schema";
   EXPECT_EQ(sizeof(core::graph::GraphOptions), 224u)
       << "GraphOptions changed: update the config schema";
-  EXPECT_EQ(sizeof(core::plan::PlanOptions), 296u)
+  EXPECT_EQ(sizeof(core::plan::PlanOptions), 304u)
       << "PlanOptions changed: update the config schema";
 }
 
