@@ -342,6 +342,10 @@ ExplorationResult ExplorationPlanner::plan_cycle(const ExplorationInput& in) {
       r.status = ExplorationStatus::kExploring;
       r.reason = "targets left to try next cycle";
       return r;
+    case LocalPlanStatus::kSettling:  // just climbed: the new floor's graph is still growing
+      r.status = ExplorationStatus::kExploring;
+      r.reason = "after a climb, waiting for the new floor's graph";
+      return r;
     case LocalPlanStatus::kBadInput:
       r.status = ExplorationStatus::kFailed;
       r.reason = "local planner rejected the input";

@@ -31,6 +31,8 @@ const char* to_string(LocalPlanStatus s) {
       return "bad_input";
     case LocalPlanStatus::kSearching:
       return "searching";
+    case LocalPlanStatus::kSettling:
+      return "settling";
   }
   return "unknown";
 }
@@ -722,7 +724,12 @@ bool LocalPlanner::to_next_flight(const LocalPlanInput& in, LocalPlanResult& out
   if (!plan_opt_.climb_blind || !plan_opt_.flight_foot) return false;
   const auto f = flight_foot(*in.view, {in.robot_foot_m}, in.robot_foot_m.z(), 0.45, 2.0, 1.0,
                              /*sparse=*/true);
-  if (!f || !free_start(in) || !to_foot_of(in, *f, out)) return false;
+  if (!f) return false;
+  if (!free_start(in) || !to_foot_of(in, *f, out)) {
+    if (next_flight_wait_until_s_ < 0) next_flight_wait_until_s_ = in.t_s + opt_.climb_settle_s;
+    return false;
+  }
+  next_flight_wait_until_s_ = -1;
   adopt_foot(in, *f, "to a flight's foot: from the landing, the next flight up", out);
   next_flight_ = true;
   return true;
@@ -1269,11 +1276,15 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
       has_target_ = committed_ = false;
     } else if (climb_start_ && reached) {
       climb_start_ = false;
-      const std::optional<FlightFoot> flight =
-          deferred_climb_ ? deferred_climb_->flight : std::nullopt;
+      std::optional<DeferredClimb> d = deferred_climb_;
       deferred_climb_.reset();
-      if (try_climb(false, flight ? &*flight : nullptr))
+      if (try_climb(false, d && d->flight ? &*d->flight : nullptr))
         return commit_climb("climb on: the floor is done, up the flight left for last");
+      // "Reached" short of its foot (the robot trailing its reference): walked to again, a bounded
+      // number of times (teaching_building seed 4, session 39: 0.47 m short, no flight found
+      // from there, "complete" with the floor above never explored).
+      if (d && plan_opt_.flight_foot && dxy > 0.15 && ++d->misses < kMaxDeferredClimbMisses)
+        deferred_climb_ = d;
       reason = "back at a flight left for last: no climb from here";
       has_target_ = false;
     } else if (!committed_ && !climb_start_ && reached && (tc || flight_target) &&
@@ -1404,6 +1415,19 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     // back down to its frontiers (teaching_building seed 1, session 24).
     if (!partial && to_next_flight(in, out)) return out;
   }
+  // The next flight's foot is seen from the landing but there is no way to it yet: the landing
+  // under the robot, reached blind, is not in the map (no start support for the voxel search, no
+  // graph node near). Wait there, trying again while the landing's map fills in, for at most
+  // climb_settle_s. Else the floor below drew the robot back down the flight just climbed and
+  // the floor above was never explored (teaching_building seed 3, session 39).
+  if (next_flight_wait_until_s_ >= 0) {
+    if (in.t_s < next_flight_wait_until_s_) {
+      if (to_next_flight(in, out)) return out;
+      out.status = LocalPlanStatus::kSettling;
+      return out;
+    }
+    next_flight_wait_until_s_ = -1;
+  }
   // No other target left on this floor: back to the flight left for last, or up it from there.
   bool climb_escape = false;  // climb_last found no way back but an escape
   auto climb_last = [&]() {
@@ -1454,6 +1478,15 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     return out;
   };
 
+  // No target: the verdict, except just after a climb, when the new floor's graph is still
+  // growing (teaching_building seed 3, session 39: "complete" 5 s after a climb onto a U-shaped
+  // stair's landing, the floor above never explored).
+  auto no_target = [&](LocalPlanStatus s) -> LocalPlanResult& {
+    const bool settling = climb_done_s_ >= 0 && in.t_s - climb_done_s_ < opt_.climb_settle_s;
+    out.status = settling ? LocalPlanStatus::kSettling : s;
+    return out;
+  };
+
   // ---- Stage 1: TSP over the cluster representatives (graph path costs).
   probe_mark(probe_, PlanStage::kLocalStage1);
   // Frontiers remain but the graph has stopped growing: they cannot be resolved from this floor
@@ -1468,8 +1501,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     if (try_climb(true)) return commit_climb("climb on: no frontier, standing on a flight");
     if (climb_last()) return to_climb("climb on: no frontier, up the flight left for last");
     if (to_flight_lead(in, out)) return out;
-    out.status = LocalPlanStatus::kNoFrontiers;
-    return out;
+    return no_target(LocalPlanStatus::kNoFrontiers);
   }
   if (!sg_fresh_) build_search_graph(g);
   uint32_t robot_node = g.root();
@@ -1550,8 +1582,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     if (to_off_graph(in, off_graph, out)) return out;
     if (retry_from_elsewhere(in, out)) return out;
     if (to_flight_lead(in, out)) return out;
-    out.status = LocalPlanStatus::kNoReachableTarget;
-    return out;
+    return no_target(LocalPlanStatus::kNoReachableTarget);
   }
   // The nearest clusters (by graph distance) enter the TSP (PlanOptions::tsp_max_clusters); the
   // rest wait for later cycles.
@@ -1659,9 +1690,11 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   // Every attempt failed. If the robot cannot turn where it stands (a dead end narrower than
   // the body's turning circle: every path back starts with a turn), the clusters are not to
   // blame: step straight to the nearest pose where it can turn, and plan again from there.
+  std::optional<LocalPlanResult> climb_deferred;  // the climb deferred here, taken up below
   if (!failed.empty() && try_climb(true)) {
     if (!other_targets(in, -1))
       return commit_climb("climb on: no way to a frontier, standing on a flight");
+    climb_deferred = out;
     defer_climb();  // other frontiers may become reachable from elsewhere
   }
   if (!failed.empty() && escape(in, out)) return commit("escape: cannot turn here");
@@ -1694,10 +1727,20 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   for (const Failed& f : failed)
     off_level = off_level && std::abs(g.node(sel[order[f.m]].rep).p_m.z() - in.robot_foot_m.z()) >
                                  robot_.step_height_m;
-  if ((boxed_in || hits_near) && (off_level || !plan_opt_.flight_foot) && plan_opt_.climb_blind &&
-      descents_ < 2 && descend_flight(in, out)) {
+  const bool way_down_blocked = (boxed_in || hits_near) && (off_level || !plan_opt_.flight_foot);
+  if (way_down_blocked && plan_opt_.climb_blind && descents_ < 2 && descend_flight(in, out)) {
     ++descents_;
     return commit("descend: boxed in on a flight, straight down its axis to the floor below");
+  }
+  // On a flight, every way down blocked (as above), no escape and no descent (none found, or two
+  // tried already): up the flight is the way on. Deferred, the frontiers below were set aside
+  // one by one until "complete" (teaching_building seed 3, session 39: mid-way up a U-shaped
+  // stair's first flight, every trajectory hit the tread behind, the floor above never explored).
+  if (climb_deferred && way_down_blocked) {
+    deferred_climb_.reset();
+    ++climbs_;  // defer_climb() gave it back
+    out = std::move(*climb_deferred);
+    return commit_climb("climb on: no way down the flight, up it");
   }
   // Stage 3 failed for these clusters: after max_failures cycles a cluster is set aside.
   for (const auto& [m, why, hit_m] : failed) {
@@ -1722,8 +1765,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   });
   if (!left && retry_from_elsewhere(in, out)) return out;
   if (!left && to_flight_lead(in, out)) return out;
-  out.status = LocalPlanStatus::kNoReachableTarget;
-  return out;
+  return no_target(LocalPlanStatus::kNoReachableTarget);
 }
 
 }  // namespace storey::core::plan

@@ -71,6 +71,7 @@ enum class LocalPlanStatus : uint8_t {
   kStartBlocked,       // no collision-free pose near the robot to start a trajectory from
   kBadInput,
   kSearching,  // targets left that this cycle's bounded work did not reach: try again next cycle
+  kSettling,   // no target yet just after a climb: the new floor's graph is still growing
 };
 const char* to_string(LocalPlanStatus s);
 
@@ -320,7 +321,8 @@ class LocalPlanner {
   bool to_flight_foot(const LocalPlanInput& in, const graph::FrontierCluster& c,
                       LocalPlanResult& out);
   // A climb ended on a landing: to the foot of a flight rising from it within 2 m (the return
-  // flight of a U-shaped stair), climbed from there whatever else is left; false if none.
+  // flight of a U-shaped stair), climbed from there whatever else is left; false if none. A foot
+  // found with no way to it yet starts a wait on the landing (next_flight_wait_until_s_).
   bool to_next_flight(const LocalPlanInput& in, LocalPlanResult& out);
   // The planned walk (out) leads to flight f's foot: f becomes the target, with no frontier.
   void adopt_foot(const LocalPlanInput& in, const FlightFoot& f, const char* reason,
@@ -413,11 +415,12 @@ class LocalPlanner {
   int climb_deferrals_ = 0;            // climbs deferred since the last climb
   int descents_ = 0;                   // descend_flight walks since the last target
   bool climb_start_ = false;
-  bool climbing_ = false;     // the committed move is a climb
-  double climb_done_s_ = -1;  // when the last climb ended
-  uint64_t landings_ = 0;     // see landings()
-  FlightAxis climb_axis_;     // climb_on's last axis (origin: the walk's foot on it)
-  FlightAxis climbing_axis_;  // the committed climb's axis
+  bool climbing_ = false;                 // the committed move is a climb
+  double climb_done_s_ = -1;              // when the last climb ended
+  double next_flight_wait_until_s_ = -1;  // to_next_flight found a foot but no way to it yet
+  uint64_t landings_ = 0;                 // see landings()
+  FlightAxis climb_axis_;                 // climb_on's last axis (origin: the walk's foot on it)
+  FlightAxis climbing_axis_;              // the committed climb's axis
   // No-progress watchdog: where and when the robot last moved (PlanOptions::no_progress_s).
   NoProgressWatchdog progress_;
   uint64_t no_progress_events_ = 0;
