@@ -725,12 +725,25 @@ bool LocalPlanner::to_next_flight(const LocalPlanInput& in, LocalPlanResult& out
   const auto f = flight_foot(*in.view, {in.robot_foot_m}, in.robot_foot_m.z(), 0.45, 2.0, 1.0,
                              /*sparse=*/true);
   if (!f) return false;
-  if (!free_start(in) || !to_foot_of(in, *f, out)) {
+  const char* reason = "to a flight's foot: from the landing, the next flight up";
+  // No path on the map: the landing, reached blind, is not in it under the robot (no start
+  // support for the voxel search, no graph node; teaching_building seed 3, session 39, for 15 s).
+  // Across the landing at its height, facing up the next flight, if the body fits on the map.
+  const auto across = [&]() {
+    if (std::abs(f->foot_m.z() - in.robot_foot_m.z()) > 0.5 * robot_.step_height_m) return false;
+    const Eigen::Vector3d to(f->foot_m.x(), f->foot_m.y(), in.robot_foot_m.z());
+    if ((to - in.robot_foot_m).head<2>().norm() < 0.1 ||
+        !straight_walk(in, {in.robot_foot_m, to}, f->yaw_rad, out))
+      return false;
+    reason = "to a flight's foot: from the landing, across it to the next flight up";
+    return true;
+  };
+  if (!free_start(in) || !(to_foot_of(in, *f, out) || across())) {
     if (next_flight_wait_until_s_ < 0) next_flight_wait_until_s_ = in.t_s + opt_.climb_settle_s;
     return false;
   }
   next_flight_wait_until_s_ = -1;
-  adopt_foot(in, *f, "to a flight's foot: from the landing, the next flight up", out);
+  adopt_foot(in, *f, reason, out);
   next_flight_ = true;
   return true;
 }
