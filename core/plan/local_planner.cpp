@@ -661,6 +661,7 @@ bool LocalPlanner::to_flight_foot(const LocalPlanInput& in, const graph::Frontie
   for (graph::NodeId n : c.nodes) near.push_back(in.graph->node(n).p_m.cast<double>());
   const auto f = flight_foot(*in.view, near, in.robot_foot_m.z());
   if (!f) return false;
+  remember_flight(*f);
   const Eigen::Vector3f foot = f->foot_m.cast<float>();
   for (const Eigen::Vector3f& q : flight_feet_tried_)
     if ((q - foot).norm() < 0.3f) return false;
@@ -720,11 +721,44 @@ bool LocalPlanner::to_flight_lead(const LocalPlanInput& in, LocalPlanResult& out
   return false;
 }
 
+void LocalPlanner::remember_flight(const FlightFoot& f) {
+  for (const FoundFlight& k : flights_found_)
+    if ((k.foot.foot_m - f.foot_m).norm() < 0.5) return;
+  flights_found_.push_back({f});
+}
+
+// No target left on this floor, but a flight found on it never led up (the robot stood on it and
+// came back down, or never climbed it): its foot, and from there the climb, before the verdict
+// (teaching_building seed 4, session 39: two descents from the first flight early on, "complete"
+// at 1034 s with the floor above never explored). A few trips per flight.
+bool LocalPlanner::to_found_flight(const LocalPlanInput& in, LocalPlanResult& out) {
+  if (!plan_opt_.climb_blind || !plan_opt_.flight_foot || !free_start(in)) return false;
+  std::vector<std::pair<double, size_t>> order;
+  for (size_t i = 0; i < flights_found_.size(); ++i) {
+    const FoundFlight& k = flights_found_[i];
+    if (k.led_up || k.trips >= kMaxFoundFlightTrips ||
+        std::abs(k.foot.foot_m.z() - in.robot_foot_m.z()) > plan_opt_.floor_node_band_m)
+      continue;
+    order.emplace_back((k.foot.foot_m - in.robot_foot_m).head<2>().norm(), i);
+  }
+  std::sort(order.begin(), order.end());
+  for (const auto& [d, i] : order) {
+    FoundFlight& k = flights_found_[i];
+    ++k.trips;
+    if (!to_foot_of(in, k.foot, out)) continue;
+    adopt_foot(in, k.foot, "to a flight's foot: no target left, a flight found here never led up",
+               out);
+    return true;
+  }
+  return false;
+}
+
 bool LocalPlanner::to_next_flight(const LocalPlanInput& in, LocalPlanResult& out) {
   if (!plan_opt_.climb_blind || !plan_opt_.flight_foot) return false;
   const auto f = flight_foot(*in.view, {in.robot_foot_m}, in.robot_foot_m.z(), 0.45, 2.0, 1.0,
                              /*sparse=*/true);
   if (!f) return false;
+  remember_flight(*f);
   const char* reason = "to a flight's foot: from the landing, the next flight up";
   // No path on the map: the landing, reached blind, is not in it under the robot (no start
   // support for the voxel search, no graph node; teaching_building seed 3, session 39, for 15 s).
@@ -1247,6 +1281,8 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
       std::abs(in.robot_foot_m.z() - deferred_climb_->foot_m.z()) > plan_opt_.floor_change_dz_m) {
     deferred_climb_.reset();
   }
+  for (FoundFlight& k : flights_found_)
+    k.led_up = k.led_up || in.robot_foot_m.z() > k.foot.foot_m.z() + kFlightLedUpM;
   out.set_aside_expired = expire_set_aside(in);
   const bool stale = floor_stale(in);
 
@@ -1495,6 +1531,7 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   // growing (teaching_building seed 3, session 39: "complete" 5 s after a climb onto a U-shaped
   // stair's landing, the floor above never explored).
   auto no_target = [&](LocalPlanStatus s) -> LocalPlanResult& {
+    if (to_found_flight(in, out)) return out;
     const bool settling = climb_done_s_ >= 0 && in.t_s - climb_done_s_ < opt_.climb_settle_s;
     out.status = settling ? LocalPlanStatus::kSettling : s;
     return out;

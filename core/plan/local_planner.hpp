@@ -445,6 +445,18 @@ class LocalPlanner {
   FlightFoot flight_foot_;      // ... this one
   bool next_flight_ = false;    // ... from a landing, its next flight's (to_next_flight)
   std::vector<Eigen::Vector3f> flight_feet_tried_;  // each foot is a target once
+  // Flights found (to_flight_foot, to_next_flight) and whether the robot has since stood
+  // kFlightLedUpM above their foot: one that never led up is gone to before "no target".
+  struct FoundFlight {
+    FlightFoot foot;
+    bool led_up = false;
+    int trips = 0;
+  };
+  static constexpr double kFlightLedUpM = 2.0;  // above a landing (half a storey), below a floor
+  static constexpr int kMaxFoundFlightTrips = 2;
+  std::vector<FoundFlight> flights_found_;
+  void remember_flight(const FlightFoot& f);
+  bool to_found_flight(const LocalPlanInput& in, LocalPlanResult& out);
 };
 
 }  // namespace storey::core::plan

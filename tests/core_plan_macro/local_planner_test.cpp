@@ -1364,21 +1364,49 @@ TEST(LocalPlanner, ATripToAFlightLeadCutShortIsTakenUpAgain) {
   const std::vector<storey::core::graph::FrontierCluster> none;
   const Eigen::Vector3f foot(-2.5f, 0.1f, 0);
   double t = 0;
-  int trips = 0;
-  for (int cycle = 0; cycle < 8; ++cycle) {
+  int trips = 0, found = 0;
+  for (int cycle = 0; cycle < 10; ++cycle) {
     LocalPlanInput in = input(h, view, foot, t);
     in.clusters = &none;
     in.last_resort = true;
     const LocalPlanResult r = lp.plan(in);
     if (r.status == LocalPlanStatus::kNewTrajectory) {
-      EXPECT_EQ(std::string(r.replan_reason).rfind("to a flight's foot", 0), 0u) << r.replan_reason;
-      ++trips;
+      const std::string reason = r.replan_reason;
+      EXPECT_EQ(reason.rfind("to a flight's foot", 0), 0u) << reason;
+      // Then the same flight as one found that never led up (to_found_flight).
+      (reason.find("never led up") != std::string::npos ? found : trips)++;
       t = r.trajectory.t_end() + 4.0;  // overdue: the robot did not move
     } else {
       t += 1.0;
     }
   }
   EXPECT_EQ(trips, 3);  // the first trip and two more (kMaxLeadTrips)
+  EXPECT_EQ(found, 2);  // kMaxFoundFlightTrips
+}
+
+// A flight found on this floor that never led up (here its foot was walked to, the trip ended
+// overdue, the robot never climbed) is gone to again once no target is left, before the
+// verdict: teaching_building seed 4 (session 39) descended its first flight twice early on and
+// ended "complete" at 1034 s with the floor above never explored. Without it: kNoFrontiers.
+TEST(LocalPlanner, AFlightFoundThatNeverLedUpIsGoneToBeforeNoTargetIsTheVerdict) {
+  Harness h;
+  observe_flight_room(h);
+  FootTrip trip(h);
+  const std::optional<LocalPlanResult> first = trip.to_foot();
+  ASSERT_TRUE(first);
+  // Much later, the robot elsewhere on the floor (it never reached the foot), no frontier left.
+  const Eigen::Vector3f far(-3.0f, -2.0f, 0);
+  double t = first->trajectory.t_end() + 30.0;
+  std::optional<LocalPlanResult> back;
+  for (int cycle = 0; cycle < 4 && !back; ++cycle, t += 1.0) {
+    LocalPlanResult r = trip.without_frontiers(far, 0.0, t);
+    if (r.status == LocalPlanStatus::kNewTrajectory) back = std::move(r);
+  }
+  ASSERT_TRUE(back.has_value());
+  EXPECT_NE(std::string(back->replan_reason).find("never led up"), std::string::npos)
+      << back->replan_reason;
+  EXPECT_LT((back->target_m - first->target_m).head<2>().norm(), 0.8)
+      << back->target_m.transpose() << " vs " << first->target_m.transpose();
 }
 
 // PlanOptions::stale_floor_s: once the floor's graph has stopped growing, a lead's flight is gone
