@@ -1396,7 +1396,11 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
       } else if (hit.collides) {
         reason = "trajectory collides on the new map";
         has_target_ = false;
-      } else if (!committed_ && !flight_target && in.t_s - planned_at_s_ >= opt_.replan_period_s) {
+      } else if (!committed_ && !flight_target && !climb_start_ &&
+                 in.t_s - planned_at_s_ >= opt_.replan_period_s) {
+        // (Not a trip back to a climb left for last: replanned every period, its route flipped
+        // between the two ways round a block of rooms and the robot never arrived;
+        // teaching_building seed 4, session 39, 954-1012 s.)
         reason = "periodic replan";
         has_target_ = false;
         kept_cluster = tc ? tc->id : -1;

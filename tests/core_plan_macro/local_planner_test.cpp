@@ -1249,6 +1249,50 @@ bool any_starts_with(const std::vector<std::string>& v, const std::string& prefi
 }
 }  // namespace
 
+// A trip back to a climb left for last is kept at periodic replans (until it collides, is
+// overdue or arrives): replanned every replan_period_s, its route flipped between the two ways
+// round a block of rooms and the robot never arrived (teaching_building seed 4, session 39).
+TEST(LocalPlanner, ATripBackToAClimbLeftForLastIsNotReplannedPeriodically) {
+  Harness h;
+  observe_flight_room(h);
+  LocalPlanner lp(RobotModel{}, climbing_options(), 0.1);
+  const auto view = h.map.view();
+  std::vector<storey::core::graph::FrontierCluster> clusters = clusters_at_foot(h);
+  for (const auto& c : h.clusters.clusters())
+    if (c.centroid_m.x() < -1.5f && c.centroid_m.y() > 1.5f && c.centroid_m.z() < 0.1f) {
+      clusters.push_back(c);
+      break;
+    }
+  Eigen::Vector3f foot(-0.45f, 0.0f, 0);
+  double yaw = 0, t = 0;
+  std::optional<LocalPlanResult> back;
+  for (int cycle = 0; cycle < 12 && !back; ++cycle) {
+    // Once the climb is left for last the robot sees to the floor's other frontiers: none left.
+    const auto r = walked_cycle(lp, h, view, clusters, foot, yaw, t);
+    if (r && std::string(r->replan_reason).rfind("climb left for last", 0) == 0) {
+      clusters.clear();
+      foot = Eigen::Vector3f(-3.3f, -2.3f, 0);  // the floor's last frontier, far from the flight
+    }
+    if (r && std::string(r->replan_reason).rfind("back to the flight left for last", 0) == 0)
+      back = r;
+  }
+  ASSERT_TRUE(back.has_value());
+  // walked_cycle put the robot at its end: back to where it was planned from, one period on.
+  const BsplineTrajectory& tr = back->trajectory;
+  const double t_on = std::min(tr.t_start() + LocalPlannerOptions{}.replan_period_s + 0.5,
+                               0.5 * (tr.t_start() + tr.t_end()));
+  const auto at = tr.pose(t_on);
+  ASSERT_GT((at.foot_m - tr.pose(tr.t_end()).foot_m).head<2>().norm(), 0.6);
+  const std::vector<storey::core::graph::FrontierCluster> none;
+  LocalPlanInput in = input(h, view, at.foot_m.cast<float>(),
+                            tr.t_start() + LocalPlannerOptions{}.replan_period_s + 0.5);
+  in.clusters = &none;
+  in.robot_yaw_rad = at.yaw_rad;
+  in.last_resort = true;
+  const LocalPlanResult r = lp.plan(in);
+  EXPECT_EQ(r.status, LocalPlanStatus::kKeep) << to_string(r.status) << " " << r.replan_reason;
+}
+
 TEST(LocalPlanner, AClimbLeftForLastIsTakenOnceTheFloorsGraphStopsGrowing) {
   const DeferralRun wait = run_deferral(0.0);  // off: the climb waits for the other cluster
   EXPECT_TRUE(any_starts_with(wait.reasons, "climb left for last"));
