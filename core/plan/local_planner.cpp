@@ -732,7 +732,7 @@ void LocalPlanner::remember_flight(const FlightFoot& f) {
 // (teaching_building seed 4, session 39: two descents from the first flight early on, "complete"
 // at 1034 s with the floor above never explored). A few trips per flight.
 bool LocalPlanner::to_found_flight(const LocalPlanInput& in, LocalPlanResult& out) {
-  if (!plan_opt_.climb_blind || !plan_opt_.flight_foot || !free_start(in)) return false;
+  if (!plan_opt_.climb_blind || !plan_opt_.flight_foot) return false;
   std::vector<std::pair<double, size_t>> order;
   for (size_t i = 0; i < flights_found_.size(); ++i) {
     const FoundFlight& k = flights_found_[i];
@@ -741,6 +741,7 @@ bool LocalPlanner::to_found_flight(const LocalPlanInput& in, LocalPlanResult& ou
       continue;
     order.emplace_back((k.foot.foot_m - in.robot_foot_m).head<2>().norm(), i);
   }
+  if (order.empty() || !free_start(in)) return false;  // (its collision check only when needed)
   std::sort(order.begin(), order.end());
   for (const auto& [d, i] : order) {
     FoundFlight& k = flights_found_[i];
@@ -1475,7 +1476,9 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   // the floor above was never explored (teaching_building seed 3, session 39).
   if (next_flight_wait_until_s_ >= 0) {
     if (in.t_s < next_flight_wait_until_s_) {
-      if (to_next_flight(in, out)) return out;
+      // (Not again in the cycle whose climb-end call started the wait: the same map.)
+      const bool started_now = next_flight_wait_until_s_ - opt_.climb_settle_s >= in.t_s;
+      if (!started_now && to_next_flight(in, out)) return out;
       out.status = LocalPlanStatus::kSettling;
       return out;
     }
@@ -1531,9 +1534,10 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
     return out;
   };
 
-  // No target: the verdict, except just after a climb, when the new floor's graph is still
-  // growing (teaching_building seed 3, session 39: "complete" 5 s after a climb onto a U-shaped
-  // stair's landing, the floor above never explored).
+  // No target: first a flight found here that never led up (to_found_flight); then the verdict,
+  // except just after a climb, when the new floor's graph is still growing (teaching_building
+  // seed 3, session 39: "complete" 5 s after a climb onto a U-shaped stair's landing, the floor
+  // above never explored).
   auto no_target = [&](LocalPlanStatus s) -> LocalPlanResult& {
     if (to_found_flight(in, out)) return out;
     const bool settling = climb_done_s_ >= 0 && in.t_s - climb_done_s_ < opt_.climb_settle_s;
