@@ -5,6 +5,7 @@
 #include <fcl/narrowphase/collision.h>
 #include <fcl/narrowphase/collision_object.h>
 
+#include <algorithm>
 #include <limits>
 
 #include <Eigen/Geometry>
@@ -202,7 +203,13 @@ CollisionHit CollisionChecker::check_poses(const map::MapView& view,
   for (BodyPose& p : adjusted_)
     if (finite(p))
       if (double mid = 0; const auto tp = terrain_pitch(view, p, &mid)) {
-        if (std::abs(*tp) < kMinTerrainPitchRad) continue;
+        if (std::abs(*tp) < kMinTerrainPitchRad) {
+          // Level under both ends: the body stands level too, whatever the path's chord says
+          // (a climb's first pose at the flight's foot is pitched up the flight; at 27 deg the
+          // rear of the box dipped into the floor behind, session 39).
+          p.pitch_rad = std::clamp(p.pitch_rad, -kMinTerrainPitchRad, kMinTerrainPitchRad);
+          continue;
+        }
         p.pitch_rad = *tp;
         p.foot_m.z() = std::max(p.foot_m.z(), mid);
       }

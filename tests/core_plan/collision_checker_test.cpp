@@ -142,6 +142,37 @@ TEST(CollisionChecker, TerrainPitchKeepsTheSeenEndOnItsSupport) {
   EXPECT_FALSE(cc.terrain_pitch(m.view(), gentle).has_value());
 }
 
+// At a flight's foot the straight walk's first pose is pitched with its first chord (27 deg
+// up the line to the landing) while the body still stands on the level floor. Where the map says
+// level under both ends the box is levelled too (within the floor-noise bound): else its rear
+// dips into the floor behind and every climb from the foot collides at its first pose (teaching
+// building seeds 4 and 5, session 39).
+TEST(CollisionChecker, APitchedPoseOnAMappedLevelFloorStandsLevel) {
+  storey::test::World w;
+  w.add(storey::test::aabb({-3.0f, -1.5f, -0.2f}, {3.0f, 1.5f, 0.0f}));  // the floor
+  for (int i = 0; i < 4; ++i)  // the flight's first risers, 0.65 m ahead of the foot
+    w.add(storey::test::aabb({0.65f + 0.3f * i, -0.6f, 0.0f},
+                             {0.65f + 0.3f * (i + 1), 0.6f, 0.17f * (i + 1)}));
+  map::TraversabilityMap m;
+  storey::test::scan_world(m, w, {{-2.0f, 0, 1.0f}, {-1.0f, 1.2f, 1.0f}, {-1.0f, -1.2f, 1.0f}});
+  CollisionChecker cc(RobotModel{}, m.view().voxel_size_m());
+  // The foot's height a few cm under the floor's mapped points (odometry against map noise).
+  const BodyPose foot{{0.0, 0, -0.02}, 0.0, 0.467};
+  const auto tp = cc.terrain_pitch(m.view(), foot);
+  ASSERT_TRUE(tp.has_value());    // both ends seen ...
+  EXPECT_LT(std::abs(*tp), 0.1);  // ... and level
+  for (const BodyPose& p :
+       {foot, BodyPose{{0.0, 0, 0.0}, 0.0, 0.6}, BodyPose{{0.0, 0, -0.02}, 0.0, -0.467}}) {
+    const std::vector<BodyPose> poses{p};
+    const CollisionHit h = cc.check_poses(m.view(), poses);
+    EXPECT_FALSE(h.collides) << "pitch " << p.pitch_rad << " voxel " << h.voxel_m.transpose();
+  }
+  // A real obstacle in the body's way still collides with the box levelled.
+  w.add(storey::test::aabb({-0.3f, -0.2f, 0.2f}, {-0.1f, 0.2f, 0.35f}));
+  storey::test::scan_world(m, w, {{-2.0f, 0, 1.0f}});
+  EXPECT_TRUE(cc.check_poses(m.view(), std::vector<BodyPose>{foot}).collides);
+}
+
 TEST(CollisionChecker, NonFinitePoseIsReportedNotSafe) {
   CollisionChecker cc(RobotModel{}, 0.1);
   std::vector<Eigen::Vector3f> vox;
