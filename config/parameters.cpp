@@ -189,6 +189,7 @@ void read_plan(SectionReader&& r, core::plan::PlanOptions& o) {
   r.get("floor_first", o.floor_first);
   r.get("reach_off_graph", o.reach_off_graph);
   r.get("keep_on_failed_replan", o.keep_on_failed_replan);
+  r.get("keep_guided_target", o.keep_guided_target);
   r.get("climb_axis_ahead_m", o.climb_axis_ahead_m, Range{0.0, 1.5});
   r.get("flight_foot", o.flight_foot);
   r.get("brake_start", o.brake_start);

@@ -294,6 +294,7 @@ ExplorationResult ExplorationPlanner::plan_cycle(const ExplorationInput& in) {
         if (!sel_clusters_.empty()) {
           li.clusters = &sel_clusters_;
           li.viewpoints = &sel_viewpoints_;
+          li.all_clusters = in.clusters;
           LocalPlanResult lr = local_.plan(li);
           if (lr.status == LocalPlanStatus::kNewTrajectory || lr.status == LocalPlanStatus::kKeep) {
             r.cluster_order = std::move(lr.cluster_order);
@@ -317,6 +318,7 @@ ExplorationResult ExplorationPlanner::plan_cycle(const ExplorationInput& in) {
         li.anchor_m.reset();
         li.clusters = in.clusters;
         li.viewpoints = in.viewpoints;
+        li.all_clusters = nullptr;
         zones_left = gp.zone_order.size() > 1;
       }
     }

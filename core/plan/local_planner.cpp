@@ -485,6 +485,13 @@ const graph::FrontierCluster* LocalPlanner::track_target(const LocalPlanInput& i
     remember_target(in, *c);
     return c;
   }
+  // Out of the guided subset only: still a frontier, still the target.
+  if (plan_opt_.keep_guided_target && in.all_clusters && target_cluster_ >= 0)
+    for (const auto& c : *in.all_clusters)
+      if (c.id == target_cluster_) {
+        remember_target(in, c);
+        return &c;
+      }
   if (target_cluster_ < 0) return nullptr;
   const graph::FrontierCluster* best = nullptr;
   float best_d = float(opt_.track_radius_m);

@@ -47,6 +47,8 @@ struct LocalPlanInput {
   const map::MapView* view = nullptr;
   const graph::ReachableGraph* graph = nullptr;
   const std::vector<graph::FrontierCluster>* clusters = nullptr;
+  // Every cluster, when `clusters` is the guided zones' subset (PlanOptions::keep_guided_target).
+  const std::vector<graph::FrontierCluster>* all_clusters = nullptr;
   const std::vector<graph::ClusterViewpoints>* viewpoints = nullptr;
   Eigen::Vector3d robot_foot_m = Eigen::Vector3d::Zero();  // ground point under the robot [m]
   double robot_yaw_rad = 0;

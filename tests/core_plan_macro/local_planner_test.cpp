@@ -240,6 +240,60 @@ TEST(LocalPlanner, TargetIsKeptWhenItsClusterOnlyChangedItsId) {
   EXPECT_NE(r2.target_cluster, 100000);
 }
 
+// PlanOptions::keep_guided_target. The guided zones' clusters (Sec. IV-C) change as the robot
+// moves: the target's cluster left out of them but still among all the clusters is kept as the
+// target; off, it reads as "observed" and the robot turns to another (maze seed 1, session 40:
+// back and forth along a corridor for 500 s). Observed for real (gone from every list): replanned.
+TEST(LocalPlanner, ATargetLeftOutOfTheGuidedClustersButStillAFrontierIsKeptWithKeepGuidedTarget) {
+  const World w = corridor();
+  Harness h;
+  ASSERT_TRUE(scan_from(h, w, Eigen::Vector3f(0, 0, 0)));
+  const auto view = h.map.view();
+  const std::vector<storey::core::graph::FrontierCluster> all = h.clusters.clusters();
+  for (bool keep : {false, true}) {
+    PlanOptions po;
+    po.keep_guided_target = keep;
+    LocalPlanner lp(RobotModel{}, po, 0.1);
+    LocalPlanInput in = input(h, view, Eigen::Vector3f(0, 1.5f, 0), 0.0);
+    in.all_clusters = &all;
+    const LocalPlanResult r0 = lp.plan(in);
+    ASSERT_EQ(r0.status, LocalPlanStatus::kNewTrajectory);
+    const int32_t target = r0.target_cluster;
+    // The guided subset: the corridor's other end only (every cluster within 1.2 m of the
+    // target's nodes left out, so that none is taken for the target under a new id).
+    std::vector<Eigen::Vector3f> target_nodes;
+    for (const auto& c : all)
+      if (c.id == target)
+        for (auto n : c.nodes) target_nodes.push_back(h.graph.node(n).p_m);
+    std::vector<storey::core::graph::FrontierCluster> guided;
+    for (const auto& c : all) {
+      bool near = false;
+      for (auto n : c.nodes)
+        for (const Eigen::Vector3f& q : target_nodes)
+          near = near || (h.graph.node(n).p_m - q).head<2>().norm() <= 1.2f;
+      if (!near) guided.push_back(c);
+    }
+    ASSERT_FALSE(guided.empty());
+    in.clusters = &guided;
+    in.t_s = 0.5;
+    const LocalPlanResult r1 = lp.plan(in);
+    if (keep) {
+      EXPECT_EQ(r1.status, LocalPlanStatus::kKeep) << r1.replan_reason;
+      EXPECT_EQ(r1.target_cluster, target);
+    } else {
+      EXPECT_STREQ(r1.replan_reason, "target cluster observed");
+      EXPECT_NE(r1.target_cluster, target);
+      continue;
+    }
+    // Gone from every list: observed, whatever the key.
+    in.all_clusters = &guided;
+    in.t_s = 1.0;
+    const LocalPlanResult r2 = lp.plan(in);
+    EXPECT_STREQ(r2.replan_reason, "target cluster observed");
+    EXPECT_NE(r2.target_cluster, target);
+  }
+}
+
 // PlanOptions::replan_only_if_faster. A periodic replan that finds the same trajectory again (the
 // robot has not moved: the same start, map and target) keeps the one followed; off, it is
 // published again, and every new trajectory starts at rest (session 20: the robot slowed down at
