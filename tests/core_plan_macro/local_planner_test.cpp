@@ -192,6 +192,25 @@ TEST(LocalPlanner, SetAsideAgainAtTheSamePlaceWaitsTwiceAsLongWithBackoff) {
   }
 }
 
+// The clusters with no node within 1.2 m (beyond track_radius_m) of cluster `id`'s nodes.
+std::vector<storey::core::graph::FrontierCluster> clusters_away_from(
+    const Harness& h, const std::vector<storey::core::graph::FrontierCluster>& clusters,
+    int32_t id) {
+  std::vector<Eigen::Vector3f> target_nodes;
+  for (const auto& c : clusters)
+    if (c.id == id)
+      for (auto n : c.nodes) target_nodes.push_back(h.graph.node(n).p_m);
+  std::vector<storey::core::graph::FrontierCluster> away;
+  for (const auto& c : clusters) {
+    bool near = false;
+    for (auto n : c.nodes)
+      for (const Eigen::Vector3f& q : target_nodes)
+        near = near || (h.graph.node(n).p_m - q).head<2>().norm() <= 1.2f;
+    if (!near) away.push_back(c);
+  }
+  return away;
+}
+
 TEST(LocalPlanner, TargetIsKeptWhenItsClusterOnlyChangedItsId) {
   const World w = corridor();
   Harness h;
@@ -219,18 +238,7 @@ TEST(LocalPlanner, TargetIsKeptWhenItsClusterOnlyChangedItsId) {
 
   // That frontier observed: every cluster with a node within track_radius_m (1 m) of the
   // target's nodes removed, the others left: replanned.
-  std::vector<Eigen::Vector3f> target_nodes;
-  for (const auto& c : renamed)
-    if (c.id == 100000)
-      for (auto n : c.nodes) target_nodes.push_back(h.graph.node(n).p_m);
-  std::vector<storey::core::graph::FrontierCluster> gone;
-  for (const auto& c : renamed) {
-    bool near = false;
-    for (auto n : c.nodes)
-      for (const Eigen::Vector3f& q : target_nodes)
-        near = near || (h.graph.node(n).p_m - q).head<2>().norm() <= 1.2f;
-    if (!near) gone.push_back(c);
-  }
+  const auto gone = clusters_away_from(h, renamed, 100000);
   ASSERT_FALSE(gone.empty());
   in.clusters = &gone;
   in.t_s = 1.0;
@@ -259,20 +267,9 @@ TEST(LocalPlanner, ATargetLeftOutOfTheGuidedClustersButStillAFrontierIsKeptWithK
     const LocalPlanResult r0 = lp.plan(in);
     ASSERT_EQ(r0.status, LocalPlanStatus::kNewTrajectory);
     const int32_t target = r0.target_cluster;
-    // The guided subset: the corridor's other end only (every cluster within 1.2 m of the
-    // target's nodes left out, so that none is taken for the target under a new id).
-    std::vector<Eigen::Vector3f> target_nodes;
-    for (const auto& c : all)
-      if (c.id == target)
-        for (auto n : c.nodes) target_nodes.push_back(h.graph.node(n).p_m);
-    std::vector<storey::core::graph::FrontierCluster> guided;
-    for (const auto& c : all) {
-      bool near = false;
-      for (auto n : c.nodes)
-        for (const Eigen::Vector3f& q : target_nodes)
-          near = near || (h.graph.node(n).p_m - q).head<2>().norm() <= 1.2f;
-      if (!near) guided.push_back(c);
-    }
+    // The guided subset: the corridor's other end only (none near enough to the target to be
+    // taken for it under a new id).
+    const auto guided = clusters_away_from(h, all, target);
     ASSERT_FALSE(guided.empty());
     in.clusters = &guided;
     in.t_s = 0.5;
