@@ -1484,7 +1484,8 @@ LocalPlanResult LocalPlanner::plan(const LocalPlanInput& in) {
   if (next_flight_wait_until_s_ >= 0) {
     if (in.t_s < next_flight_wait_until_s_) {
       // (Not again in the cycle whose climb-end call started the wait: the same map.)
-      const bool started_now = next_flight_wait_until_s_ - opt_.climb_settle_s >= in.t_s;
+      // (The very expression that set it: exact, no rounding of a subtraction.)
+      const bool started_now = in.t_s + opt_.climb_settle_s == next_flight_wait_until_s_;
       if (!started_now && to_next_flight(in, out)) return out;
       out.status = LocalPlanStatus::kSettling;
       return out;
