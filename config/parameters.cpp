@@ -262,6 +262,7 @@ void read_safety(SectionReader&& r, SafetyConfig& o) {
   r.get("lookahead_on_plan_grid", o.lookahead_on_plan_grid);
   r.get("reference_yaw_gate_rad", o.reference_yaw_gate_rad, Range{0.05, 3.0});
   r.get("reference_speed_lead_mps", o.reference_speed_lead_mps, Range{0.0, 5.0});
+  r.get("check_body_turn", o.check_body_turn);
 }
 
 void read_link(SectionReader&& r, LinkConfig& o) {

@@ -92,6 +92,11 @@ struct SafetyConfig {
   // nearly to rest ran 0.3 m ahead round a bend, and the body cut it into a wall (house seed 1,
   // session 32). 0: off [m/s].
   double reference_speed_lead_mps = 0.0;
+  // The look-ahead also checks the poses the body sweeps as it closes its yaw error to the
+  // reference (ControlLaw::turn_poses) at its own position: a body 0.15 m off a new trajectory's
+  // start turned 0.3 rad towards it into a door jamb, between poses each checked at the
+  // reference's position (office seed 2, session 40). Session 41: off.
+  bool check_body_turn = false;
 };
 
 enum class LinkTransport { kDds, kUdp, kCan, kSim };

@@ -571,9 +571,20 @@ void Autonomy::control_step() {
     const core::map::MapView view = wv.ptr->map->view();
     const auto pose_at = [&](double s) { return pose_on(t, s); };
     const bool on_grid = opt_.params.safety.lookahead_on_plan_grid;
-    const core::plan::CollisionHit hit =
+    core::plan::CollisionHit hit =
         on_grid ? lookahead_.check_on_grid(view, pose_at, t.t_start(), t.t_end(), tau_, horizon)
                 : lookahead_.check_ahead(view, pose_at, tau_, horizon, 0.0);
+    // safety.check_body_turn: the body's own turn towards the reference, where the body is. A
+    // body whose own pose already overlaps (its margin at a jamb seen late) is not stopped for
+    // it: the planner starts from the nearest clear pose (LocalPlanner::free_start).
+    if (!hit.collides && opt_.params.safety.check_body_turn && following) {
+      law_.turn_poses(ref, last_pose_, turn_poses_);
+      if (!turn_poses_.empty()) {
+        const core::plan::BodyPose here{last_pose_.position(), last_pose_.yaw_rad, 0.0, now};
+        if (!lookahead_.check_poses(view, std::span(&here, 1)).collides)
+          hit = lookahead_.check_poses(view, turn_poses_);
+      }
+    }
     if (hit.collides && (!collision_predicted_ || (on_grid && new_traj)))
       replan_request_.store(true, std::memory_order_release);
     collision_predicted_ = hit.collides;

@@ -287,6 +287,7 @@ class Autonomy {
   ControlLaw law_;
   SafetyMonitor safety_;
   core::plan::CollisionChecker lookahead_;
+  std::vector<core::plan::BodyPose> turn_poses_;  // safety.check_body_turn (ControlLaw::turn_poses)
   uint64_t ctl_traj_version_ = 0, ctl_checked_traj_ = 0, ctl_checked_map_ = 0;
   std::shared_ptr<const PlannedTrajectory> ctl_traj_;
   double tau_ = 0;    // progress along the trajectory [s] (advances while tracking well)

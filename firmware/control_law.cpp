@@ -53,6 +53,21 @@ VelocityCommand ControlLaw::limit(VelocityCommand cmd, const VelocityCommand& pr
   return cmd;
 }
 
+void ControlLaw::turn_poses(const core::plan::TrajectorySample& ref, const PoseSample& pose,
+                            std::vector<core::plan::BodyPose>& out) const {
+  out.clear();
+  const double dyaw = wrap_angle(ref.yaw_rad - pose.yaw_rad);
+  if (!(std::abs(dyaw) >= kTurnMinRad) || !ref.p_m.allFinite()) return;
+  const Eigen::Vector3d from = pose.position(), to = ref.p_m;
+  const double ratio = gains_.k_position / std::max(gains_.k_yaw, 1e-3);
+  const int n = int(std::ceil(std::abs(dyaw) / kTurnStepRad));
+  for (int k = 1; k <= n; ++k) {
+    const double f = double(k) / n, g = 1.0 - std::pow(1.0 - f, ratio);
+    out.push_back(
+        core::plan::BodyPose{from + g * (to - from), pose.yaw_rad + f * dyaw, 0.0, pose.stamp_s});
+  }
+}
+
 double ControlLaw::on_reference(const core::plan::TrajectorySample& ref,
                                 const PoseSample& pose) const {
   const double g = std::clamp((0.3 - braking_gap(ref, pose)) / 0.15, 0.0, 1.0);

@@ -3,6 +3,8 @@
 // velocity of the reference + proportional correction of the position and yaw errors, clamped to
 // the robot's limits (planar speed, yaw rate) and rate-limited (planar acceleration, yaw
 // acceleration) against the previous command. Pure function of its inputs: no state, no clock.
+#include <vector>
+
 #include "core/plan/bspline_trajectory.hpp"
 #include "core/robot_model.hpp"
 #include "firmware/platform.hpp"
@@ -68,6 +70,16 @@ class ControlLaw {
   // corners the reference goes round. 1 with lead_mps <= 0 (off).
   static double speed_rate(const Eigen::Vector2d& ref_v, const Eigen::Vector2d& robot_v,
                            double lead_mps);
+  // safety.check_body_turn: the poses the body sweeps from `pose` as it closes its yaw error to
+  // ref, at most kTurnStepRad apart, ending at ref's yaw; empty under kTurnMinRad of error. The
+  // proportional law closes the yaw error at k_yaw and the position error at k_position, so at
+  // a fraction f of the turn the body has covered 1 - (1 - f)^(k_position / k_yaw) of the way to
+  // ref's position: it turns mostly where it is, which is not where the trajectory's poses were
+  // checked when the body is off its reference (pitch 0: the checker puts it on the terrain;
+  // t_s: the pose's stamp).
+  void turn_poses(const core::plan::TrajectorySample& ref, const PoseSample& pose,
+                  std::vector<core::plan::BodyPose>& out) const;
+  static constexpr double kTurnStepRad = 0.1, kTurnMinRad = 0.15;
   // Clamps a command to speed / yaw-rate limits and rate-limits it against prev (exposed for
   // tests).
   VelocityCommand limit(VelocityCommand cmd, const VelocityCommand& prev, double dt_s) const;

@@ -296,6 +296,52 @@ TEST(ControlLaw, TheReferenceIsNoFasterThanTheRobotCanFollow) {
   EXPECT_LT(held, 0.03);
 }
 
+// safety.check_body_turn (office seed 2, session 40): a body 0.3 m ahead of a new trajectory's
+// start, beside a door jamb, turns 0.6 rad towards the reference's yaw mostly where it stands.
+// The reference's own pose is clear of the jamb; the body's turn is not.
+TEST(ControlLaw, TheBodysTurnTowardsItsReferenceIsSweptWhereTheBodyIs) {
+  core::RobotModel robot;
+  ControlLaw law(robot);
+  PoseSample pose;  // at the origin, yaw 0
+  pose.stamp_s = 12.0;
+  const auto ref = ref_at(-0.3, 0, 0, 0, 0.6);
+  std::vector<core::plan::BodyPose> poses;
+  law.turn_poses(ref, pose, poses);
+  ASSERT_EQ(poses.size(), 6u);  // 0.6 rad in steps of at most 0.1
+  double prev_yaw = pose.yaw_rad, prev_x = 0;
+  for (const core::plan::BodyPose& p : poses) {
+    EXPECT_LE(p.yaw_rad - prev_yaw, ControlLaw::kTurnStepRad + 1e-9);
+    EXPECT_GT(p.yaw_rad, prev_yaw);
+    EXPECT_LE(p.foot_m.x(), prev_x);  // on the way to the reference
+    // The yaw error closes faster than the position error (k_yaw 2 > k_position 1.2).
+    EXPECT_GE(p.yaw_rad / 0.6, p.foot_m.x() / -0.3 - 1e-9);
+    EXPECT_EQ(p.t_s, 12.0);
+    prev_yaw = p.yaw_rad, prev_x = p.foot_m.x();
+  }
+  EXPECT_NEAR(poses.back().yaw_rad, 0.6, 1e-12);
+  EXPECT_NEAR((poses.back().foot_m - ref.p_m).norm(), 0.0, 1e-12);
+  EXPECT_LT(poses[2].foot_m.x(), 0.0);
+  EXPECT_GT(poses[2].foot_m.x(), -0.15);  // half turned, under half way
+
+  // A jamb along +x 0.3 m to the body's left (0.1 m voxels, 0.2-0.4 m up).
+  std::vector<Eigen::Vector3f> jamb;
+  for (float x = 0.25f; x < 0.6f; x += 0.1f)
+    for (float z = 0.25f; z < 0.4f; z += 0.1f) jamb.emplace_back(x, 0.3f, z);
+  core::plan::CollisionChecker checker(robot, 0.1);
+  const core::plan::BodyPose here{pose.position(), 0.0, 0.0, 12.0};
+  const core::plan::BodyPose at_ref{ref.p_m, ref.yaw_rad, 0.0, 12.0};
+  EXPECT_FALSE(checker.check_poses(std::span(&here, 1), jamb).collides);
+  EXPECT_FALSE(checker.check_poses(std::span(&at_ref, 1), jamb).collides);
+  EXPECT_TRUE(checker.check_poses(poses, jamb).collides);
+
+  // Under 0.15 rad of yaw error nothing is swept (tracking closes it on the way).
+  law.turn_poses(ref_at(-0.3, 0, 0, 0, 0.14), pose, poses);
+  EXPECT_TRUE(poses.empty());
+  law.turn_poses(ref_at(-0.3, 0, 0, 0, -0.16), pose, poses);
+  EXPECT_EQ(poses.size(), 2u);
+  EXPECT_NEAR(poses.back().yaw_rad, -0.16, 1e-12);
+}
+
 TEST(ControlLaw, FeedforwardInBodyFrameAndNanGuard) {
   core::RobotModel robot;
   ControlLaw law(robot);
