@@ -115,6 +115,30 @@ std::vector<Goal> FaelLikePlanner::goals(const plan::ExplorationInput& in) {
   const int32_t s = sy * nx + sx;
   dist_[size_t(s)] = 0;
   q.push({0, s});
+  // The robot's own cell may read as an obstacle of the plane: a table top the robot walked
+  // under, seen once it was there, is an elevation change to the 2.5D projection
+  // (teaching_building: "complete" at 35 s in the first classroom). It walks out first, straight
+  // to the nearest free, uninflated cell within kExitM (its trajectory is FCL-checked like any).
+  if (grid_.at(sx, sy) != GridCell::kFree) {
+    constexpr double kExitM = 1.0;
+    const int r = int(std::ceil(kExitM / res));
+    int32_t exit = -1;
+    double exit_d = std::numeric_limits<double>::infinity();
+    for (int dy = -r; dy <= r; ++dy)
+      for (int dx = -r; dx <= r; ++dx) {
+        const int x = sx + dx, y = sy + dy;
+        const double d = res * std::hypot(dx, dy);
+        if (d > kExitM || d >= exit_d || !grid_.inside(x, y) || grid_.at(x, y) != GridCell::kFree ||
+            blocked_[size_t(y) * size_t(nx) + size_t(x)])
+          continue;
+        exit_d = d, exit = y * nx + x;
+      }
+    if (exit >= 0) {
+      dist_[size_t(exit)] = exit_d;
+      parent_[size_t(exit)] = s;
+      q.push({exit_d, exit});
+    }
+  }
   while (!q.empty()) {
     const auto [d, u] = q.top();
     q.pop();
@@ -202,7 +226,8 @@ std::vector<Goal> FaelLikePlanner::goals(const plan::ExplorationInput& in) {
     std::vector<Eigen::Vector3d> rev;
     int k = 0;
     for (int32_t u = best; u >= 0; u = parent_[size_t(u)], ++k) {
-      if (u != best && parent_[size_t(u)] >= 0 && k % 3) continue;
+      const bool exit_step = parent_[size_t(u)] == s && grid_.at(sx, sy) != GridCell::kFree;
+      if (u != best && parent_[size_t(u)] >= 0 && !exit_step && k % 3) continue;
       const Eigen::Vector2d p = grid_.centre(u % nx, u / nx);
       rev.push_back({p.x(), p.y(), grid_.height(u % nx, u / nx)});
     }

@@ -166,6 +166,32 @@ TEST(FaelLike, TreatsAStairAsAnObstacle) {
   }
 }
 
+// A table (top 0.7-0.75 m) in a corridor, its top seen from above: on the 2.5D plane an
+// elevation change, so the floor under it is an obstacle. A robot that walked under it (the
+// body fits) before the top was seen still has goals: it walks out first (teaching_building,
+// session 40: "complete" at 35 s in the first classroom, no goal from inside the table's cells).
+TEST(FaelLike, ARobotUnderATableWalksOutFirst) {
+  World w = corridor_along_x(10);
+  w.add(aabb({-0.8f, -0.5f, 0.70f}, {0.8f, 0.5f, 0.75f}));
+  map::TraversabilityMap m;
+  scan(m, w, {{-2.0f, 0, 1.4f}, {2.0f, 0, 1.4f}}, 5.0f);
+  const map::MapView view = m.view();
+  FaelLikePlanner p(RobotModel{}, plan::PlanOptions{}, 0.1);
+  const auto goals = p.goals(input_at(view, {0.0, 0.0, 0.0}));
+  ASSERT_EQ(p.grid().at_m(0.0, 0.0), GridCell::kObstacle);  // the table top, projected
+  ASSERT_FALSE(goals.empty());
+  for (const Goal& g : goals) {
+    ASSERT_GE(g.path_m.size(), 2u);
+    EXPECT_LT(g.path_m.front().head<2>().norm(), 0.11);  // from the robot
+    // out from under the table's footprint (0.8 x 0.5 m half sizes) within the exit radius
+    const Eigen::Vector3d& out = g.path_m[1];  // the exit, kept in every path
+    EXPECT_TRUE(std::abs(out.x()) > 0.75 || std::abs(out.y()) > 0.45)
+        << out.transpose() << " is under the table";
+    EXPECT_LE(out.head<2>().norm(), 1.0 + 1e-9);
+    EXPECT_GE(out.head<2>().norm(), 0.45);  // the nearest free cell, not a later one
+  }
+}
+
 // The same stairs for tare-like's path rule, against the voxel A*: a path up the flight is
 // refused, one along the floor is accepted.
 TEST(TareLike, RefusesThePathUpAStairFlight) {
