@@ -75,8 +75,9 @@ struct SafetyConfig {
   double link_timeout_s = 0.25;     // no robot state over the link for longer -> stop
   double lookahead_s = 1.0;         // predicted collision within this horizon -> stop
   int max_overruns = 3;             // consecutive control-task budget overruns -> stop
-  // Session 13 switches, off (docs/RESULTS.md session 13): each fixes a failure it was measured
-  // on, and each moved which seeds end with a floor unreached.
+  // Session 13 switches, off in the structs (docs/RESULTS.md session 13): each fixes a failure it
+  // was measured on, and each moved which seeds end with a floor unreached. config/default.yaml
+  // turns both on (lookahead_on_plan_grid since session 18, turn_on_reference since 41).
   // Turn only where the robot will come to rest on the reference (ControlLaw::on_reference): a
   // robot overshooting a new trajectory's start turned its body into a door frame.
   bool turn_on_reference = false;
@@ -95,7 +96,8 @@ struct SafetyConfig {
   // The look-ahead also checks the poses the body sweeps as it closes its yaw error to the
   // reference (ControlLaw::turn_poses) at its own position: a body 0.15 m off a new trajectory's
   // start turned 0.3 rad towards it into a door jamb, between poses each checked at the
-  // reference's position (office seed 2, session 40). Session 41: off.
+  // reference's position (office seed 2, session 40). Off (session 41): its stop-and-replan
+  // answer used up the trips to the teaching building's U-stair (seed 2, "complete" downstairs).
   bool check_body_turn = false;
 };
 

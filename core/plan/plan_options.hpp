@@ -188,11 +188,12 @@ struct PlanOptions {
   // set_aside_backoff) went back down to a viewpoint on the top tread, turned on the treads and
   // wedged the body crossing the landing's edge diagonally.
   bool no_views_on_climbed_flights = false;
-  // Beyond the paper, off (session 40): the target's cluster, gone from the guided zones' clusters
-  // (Sec. IV-C: the tour's first zones change as the robot moves) but still a frontier cluster, is
-  // kept as the target until it is observed or reached, not dropped as "observed". Maze seed 1 at
-  // 8263464: the first zone flipped between a corridor's two ends and the robot turned back and
-  // forth there for 500 s (393 "target cluster observed" replans over the run, ~130 in the others).
+  // Beyond the paper, off here (session 40; on in config/default.yaml since 41): the target's
+  // cluster, gone from the guided zones' clusters (Sec. IV-C: the tour's first zones change as the
+  // robot moves) but still a frontier cluster, is kept as the target until it is observed or
+  // reached, not dropped as "observed". Maze seed 1 at 8263464: the first zone flipped between a
+  // corridor's two ends and the robot turned back and forth there for 500 s (393 "target cluster
+  // observed" replans over the run, ~130 in the others).
   bool keep_guided_target = false;
   bool incremental_maintenance = true;
 };
