@@ -79,6 +79,8 @@ Autonomy::Autonomy(Platform& platform, const rt::Clock& clock, AutonomyOptions o
     free_q_.try_push(&b);
   }
   drop_buf_.points_m.reserve(opt_.scan_reserve_points);
+  // ControlLaw::turn_poses: at most pi / kTurnStepRad poses; no allocation in the control task.
+  turn_poses_.reserve(size_t(std::ceil(M_PI / ControlLaw::kTurnStepRad)) + 1);
   if (!policy_->local_layer())
     idle_local_ = std::make_unique<core::plan::LocalPlanner>(opt_.params.robot, opt_.params.plan,
                                                              opt_.params.map.voxel_size_m);
