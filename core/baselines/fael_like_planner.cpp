@@ -119,7 +119,8 @@ std::vector<Goal> FaelLikePlanner::goals(const plan::ExplorationInput& in) {
   // under, seen once it was there, is an elevation change to the 2.5D projection
   // (teaching_building: "complete" at 35 s in the first classroom). It walks out first, straight
   // to the nearest free, uninflated cell within kExitM (its trajectory is FCL-checked like any).
-  if (grid_.at(sx, sy) != GridCell::kFree) {
+  const bool walk_out = grid_.at(sx, sy) != GridCell::kFree;
+  if (walk_out) {
     constexpr double kExitM = 1.0;
     const int r = int(std::ceil(kExitM / res));
     int32_t exit = -1;
@@ -226,7 +227,7 @@ std::vector<Goal> FaelLikePlanner::goals(const plan::ExplorationInput& in) {
     std::vector<Eigen::Vector3d> rev;
     int k = 0;
     for (int32_t u = best; u >= 0; u = parent_[size_t(u)], ++k) {
-      const bool exit_step = parent_[size_t(u)] == s && grid_.at(sx, sy) != GridCell::kFree;
+      const bool exit_step = walk_out && parent_[size_t(u)] == s;
       if (u != best && parent_[size_t(u)] >= 0 && !exit_step && k % 3) continue;
       const Eigen::Vector2d p = grid_.centre(u % nx, u / nx);
       rev.push_back({p.x(), p.y(), grid_.height(u % nx, u / nx)});
