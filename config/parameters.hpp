@@ -96,8 +96,10 @@ struct SafetyConfig {
   // The look-ahead also checks the poses the body sweeps as it closes its yaw error to the
   // reference (ControlLaw::turn_poses) at its own position: a body 0.15 m off a new trajectory's
   // start turned 0.3 rad towards it into a door jamb, between poses each checked at the
-  // reference's position (office seed 2, session 40). Off (session 41): its stop-and-replan
-  // answer used up the trips to the teaching building's U-stair (seed 2, "complete" downstairs).
+  // reference's position (office seed 2, session 40). A turn that would collide is held while
+  // the body slides onto its reference, if that and the turn there are clear
+  // (ControlLaw::slide_poses); else stop and replan. Off (session 41): stop-and-replan alone used
+  // up the trips to the teaching building's U-stair (seed 2, "complete" downstairs).
   bool check_body_turn = false;
 };
 

@@ -79,8 +79,8 @@ Autonomy::Autonomy(Platform& platform, const rt::Clock& clock, AutonomyOptions o
     free_q_.try_push(&b);
   }
   drop_buf_.points_m.reserve(opt_.scan_reserve_points);
-  // ControlLaw::turn_poses: at most pi / kTurnStepRad poses; no allocation in the control task.
-  turn_poses_.reserve(size_t(std::ceil(M_PI / ControlLaw::kTurnStepRad)) + 1);
+  // ControlLaw::turn_poses / slide_poses: no allocation in the control task.
+  turn_poses_.reserve(ControlLaw::max_swept_poses());
   if (!policy_->local_layer())
     idle_local_ = std::make_unique<core::plan::LocalPlanner>(opt_.params.robot, opt_.params.plan,
                                                              opt_.params.map.voxel_size_m);
@@ -496,6 +496,7 @@ void Autonomy::control_step() {
     pending_.reset();
     brake_k_ = 1.0;
     entering_ = true;
+    hold_turn_ = false;
     if (ctl_traj_ && !ctl_traj_->trajectory.empty())
       tau_ = ControlLaw::entry_time(ctl_traj_->trajectory,
                                     Eigen::Vector2d(last_pose_.x_m, last_pose_.y_m));
@@ -578,13 +579,23 @@ void Autonomy::control_step() {
                 : lookahead_.check_ahead(view, pose_at, tau_, horizon, 0.0);
     // safety.check_body_turn: the body's own turn towards the reference, where the body is. A
     // body whose own pose already overlaps (its margin at a jamb seen late) is not stopped for
-    // it: the planner starts from the nearest clear pose (LocalPlanner::free_start).
+    // it: the planner starts from the nearest clear pose (LocalPlanner::free_start). A turn that
+    // would collide is first held while the body slides onto its reference, if that and the
+    // turn there are clear (ControlLaw::slide_poses); only then stop and replan (a stop asks
+    // for a new plan, which drops the target: at the teaching building's U-stair every trip
+    // up the flight was used up so, session 41).
+    hold_turn_ = false;
     if (!hit.collides && opt_.params.safety.check_body_turn && following) {
       law_.turn_poses(ref, last_pose_, turn_poses_);
       if (!turn_poses_.empty()) {
         const core::plan::BodyPose here{last_pose_.position(), last_pose_.yaw_rad, 0.0, now};
         if (!lookahead_.check_poses(view, std::span(&here, 1)).collides)
           hit = lookahead_.check_poses(view, turn_poses_);
+        if (hit.collides) {
+          law_.slide_poses(ref, last_pose_, turn_poses_);
+          if (!turn_poses_.empty() && !lookahead_.check_poses(view, turn_poses_).collides)
+            hit = core::plan::CollisionHit{}, hold_turn_ = true;
+        }
       }
     }
     if (hit.collides && (!collision_predicted_ || (on_grid && new_traj)))
@@ -623,7 +634,8 @@ void Autonomy::control_step() {
   VelocityCommand cmd;
   if (!d.stop && following) {
     entering_ = entering_ && law_.on_reference(ref, last_pose_) < 1.0;
-    cmd = law_.track(ref, last_pose_, prev_cmd_, dt, entering_);
+    hold_turn_ = hold_turn_ && err > ControlLaw::kSlideStepM;  // on it: the turn was checked
+    cmd = law_.track(ref, last_pose_, prev_cmd_, dt, entering_, hold_turn_);
     // Progress along the curve only while tracking well: after a stop or a lag the reference
     // waits for the robot instead of running away from it.
     const double rate = ControlLaw::progress_rate(err, wrap_angle(ref.yaw_rad - last_pose_.yaw_rad),

@@ -293,7 +293,8 @@ class Autonomy {
   double tau_ = 0;    // progress along the trajectory [s] (advances while tracking well)
   double lag_s_ = 0;  // now - tau_ while tau_ runs (TrajectoryProgress)
   rt::Mailbox<TrajectoryProgress> progress_mb_;
-  bool entering_ = false;  // a new trajectory the robot has not yet been on (turn_on_reference)
+  bool hold_turn_ = false;  // safety.check_body_turn: slide onto the reference, then turn
+  bool entering_ = false;   // a new trajectory the robot has not yet been on (turn_on_reference)
   // plan.brake_start: a new trajectory waits while the robot brakes on the one it follows; the
   // old one's progress and feedforward scaled by brake_k_, falling 1 -> 0 at a_max from brake_v0_.
   std::shared_ptr<const PlannedTrajectory> pending_;

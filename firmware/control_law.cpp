@@ -12,7 +12,8 @@ double wrap_angle(double a) {
 }
 
 VelocityCommand ControlLaw::track(const core::plan::TrajectorySample& ref, const PoseSample& pose,
-                                  const VelocityCommand& prev, double dt_s, bool entering) const {
+                                  const VelocityCommand& prev, double dt_s, bool entering,
+                                  bool hold_yaw) const {
   // World-frame planar velocity: feedforward + P on the position error.
   const double wx = ref.v_mps.x() + gains_.k_position * (ref.p_m.x() - pose.x_m);
   const double wy = ref.v_mps.y() + gains_.k_position * (ref.p_m.y() - pose.y_m);
@@ -20,7 +21,9 @@ VelocityCommand ControlLaw::track(const core::plan::TrajectorySample& ref, const
   VelocityCommand cmd;
   cmd.vx_mps = c * wx + s * wy;  // rotate into the body frame
   cmd.vy_mps = -s * wx + c * wy;
-  cmd.yaw_rate_rps = (gains_.turn_on_reference && entering ? on_reference(ref, pose) : 1.0) *
+  cmd.yaw_rate_rps = (hold_yaw                               ? 0.0
+                      : gains_.turn_on_reference && entering ? on_reference(ref, pose)
+                                                             : 1.0) *
                      (ref.yaw_rate_rps + gains_.k_yaw * wrap_angle(ref.yaw_rad - pose.yaw_rad));
   return limit(cmd, prev, dt_s);
 }
@@ -66,6 +69,27 @@ void ControlLaw::turn_poses(const core::plan::TrajectorySample& ref, const PoseS
     out.push_back(
         core::plan::BodyPose{from + g * (to - from), pose.yaw_rad + f * dyaw, 0.0, pose.stamp_s});
   }
+}
+
+void ControlLaw::slide_poses(const core::plan::TrajectorySample& ref, const PoseSample& pose,
+                             std::vector<core::plan::BodyPose>& out) const {
+  out.clear();
+  const double dyaw = wrap_angle(ref.yaw_rad - pose.yaw_rad);
+  const Eigen::Vector3d from = pose.position(), to = ref.p_m;
+  const double d = (to - from).head<2>().norm();
+  if (!(std::abs(dyaw) >= kTurnMinRad) || !(d <= kSlideMaxM) || !to.allFinite()) return;
+  const int n = int(std::ceil(d / kSlideStepM));
+  for (int k = 1; k <= n; ++k)
+    out.push_back(core::plan::BodyPose{from + (double(k) / n) * (to - from), pose.yaw_rad, 0.0,
+                                       pose.stamp_s});
+  const int m = int(std::ceil(std::abs(dyaw) / kTurnStepRad));
+  for (int k = 1; k <= m; ++k)
+    out.push_back(
+        core::plan::BodyPose{to, pose.yaw_rad + (double(k) / m) * dyaw, 0.0, pose.stamp_s});
+}
+
+size_t ControlLaw::max_swept_poses() {
+  return size_t(std::ceil(kSlideMaxM / kSlideStepM)) + size_t(std::ceil(M_PI / kTurnStepRad)) + 2;
 }
 
 double ControlLaw::on_reference(const core::plan::TrajectorySample& ref,

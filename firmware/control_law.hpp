@@ -27,8 +27,10 @@ class ControlLaw {
   // `entering` a new trajectory (until the robot first came to be on it): the robot turns only
   // where it will come to rest on the reference. Once on it, full yaw authority (a robot lagging
   // its reference on a flight, the gate held the yaw off the axis and the climbs failed).
+  // hold_yaw: no yaw command (safety.check_body_turn: the body slides onto its reference first).
   VelocityCommand track(const core::plan::TrajectorySample& ref, const PoseSample& pose,
-                        const VelocityCommand& prev, double dt_s, bool entering = true) const;
+                        const VelocityCommand& prev, double dt_s, bool entering = true,
+                        bool hold_yaw = false) const;
   // 1 while the point where the robot would stop if it braked now is within 0.15 m of the
   // reference's, falling to 0 at 0.3 m. A new trajectory starts at rest where the robot was when
   // it was planned; a robot arriving at walking speed overshoots that start by up to
@@ -80,6 +82,16 @@ class ControlLaw {
   void turn_poses(const core::plan::TrajectorySample& ref, const PoseSample& pose,
                   std::vector<core::plan::BodyPose>& out) const;
   static constexpr double kTurnStepRad = 0.1, kTurnMinRad = 0.15;
+  // safety.check_body_turn's answer when turn_poses collide: the poses of a body that holds its
+  // yaw while it slides to ref's position (at most kSlideStepM apart), then turns there to ref's
+  // yaw, where the trajectory's own poses were checked. Empty when the body is more than
+  // kSlideMaxM off (the reference waits for it from 0.6 m anyway) or under kTurnMinRad off.
+  void slide_poses(const core::plan::TrajectorySample& ref, const PoseSample& pose,
+                   std::vector<core::plan::BodyPose>& out) const;
+  static constexpr double kSlideStepM = 0.1, kSlideMaxM = 0.6;
+  // Upper bound on the poses turn_poses and slide_poses yield (to reserve, never to allocate in
+  // the control task).
+  static size_t max_swept_poses();
   // Clamps a command to speed / yaw-rate limits and rate-limits it against prev (exposed for
   // tests).
   VelocityCommand limit(VelocityCommand cmd, const VelocityCommand& prev, double dt_s) const;

@@ -342,6 +342,53 @@ TEST(ControlLaw, TheBodysTurnTowardsItsReferenceIsSweptWhereTheBodyIs) {
   EXPECT_NEAR(poses.back().yaw_rad, -0.16, 1e-12);
 }
 
+TEST(ControlLaw, ABodyWhoseTurnWouldSweepAJambSlidesOntoItsReferenceAndTurnsThere) {
+  core::RobotModel robot;
+  ControlLaw law(robot);
+  PoseSample pose;  // at the origin, yaw 0
+  pose.stamp_s = 3.0;
+  const auto ref = ref_at(-0.3, 0, 0, 0, 0.6);
+  std::vector<core::plan::BodyPose> poses;
+  law.slide_poses(ref, pose, poses);
+  ASSERT_EQ(poses.size(), 3u + 6u);  // 0.3 m in 0.1 m steps, then 0.6 rad in 0.1 rad steps
+  for (size_t k = 0; k < 3; ++k) {
+    EXPECT_EQ(poses[k].yaw_rad, 0.0);  // the yaw held while it slides
+    EXPECT_NEAR(poses[k].foot_m.x(), -0.1 * double(k + 1), 1e-12);
+  }
+  for (size_t k = 3; k < poses.size(); ++k) {
+    EXPECT_NEAR((poses[k].foot_m - ref.p_m).norm(), 0.0, 1e-12);  // turns on the reference
+    EXPECT_NEAR(poses[k].yaw_rad, 0.1 * double(k - 2), 1e-12);
+    EXPECT_EQ(poses[k].t_s, 3.0);
+  }
+  EXPECT_LE(poses.size(), ControlLaw::max_swept_poses());
+
+  // The jamb the proportional turn sweeps (TheBodysTurnTowardsItsReferenceIsSweptWhereTheBodyIs)
+  // is clear of the slide and of the turn on the reference.
+  std::vector<Eigen::Vector3f> jamb;
+  for (float x = 0.25f; x < 0.6f; x += 0.1f)
+    for (float z = 0.25f; z < 0.4f; z += 0.1f) jamb.emplace_back(x, 0.3f, z);
+  core::plan::CollisionChecker checker(robot, 0.1);
+  std::vector<core::plan::BodyPose> turn;
+  law.turn_poses(ref, pose, turn);
+  EXPECT_TRUE(checker.check_poses(turn, jamb).collides);
+  EXPECT_FALSE(checker.check_poses(poses, jamb).collides);
+
+  // While it slides no yaw is commanded; the position is still tracked.
+  const VelocityCommand held = law.track(ref, pose, VelocityCommand{}, 0.02, false, true);
+  EXPECT_EQ(held.yaw_rate_rps, 0.0);
+  EXPECT_LT(held.vx_mps, 0.0);
+  EXPECT_GT(law.track(ref, pose, VelocityCommand{}, 0.02, false, false).yaw_rate_rps, 0.0);
+
+  // Nothing to slide: under kTurnMinRad off, or further off than kSlideMaxM (the reference waits
+  // for the robot from 0.6 m), or a non-finite reference.
+  law.slide_poses(ref_at(-0.3, 0, 0, 0, 0.1), pose, poses);
+  EXPECT_TRUE(poses.empty());
+  law.slide_poses(ref_at(-0.7, 0, 0, 0, 0.6), pose, poses);
+  EXPECT_TRUE(poses.empty());
+  law.slide_poses(ref_at(std::nan(""), 0, 0, 0, 0.6), pose, poses);
+  EXPECT_TRUE(poses.empty());
+}
+
 TEST(ControlLaw, FeedforwardInBodyFrameAndNanGuard) {
   core::RobotModel robot;
   ControlLaw law(robot);
