@@ -74,8 +74,14 @@ class GoalDriver {
   // failed this cycle (failing goals are set aside after max_failures cycles).
   void choose(const plan::ExplorationInput& in, std::vector<Goal>& goals,
               plan::ExplorationResult& r);
-  // Stage 3 to one goal: voxel A* (or the goal's own polyline), centring, B-spline.
+  // Stage 3 to one goal: voxel A* (or the goal's own polyline), centring, B-spline. From a rest
+  // start away from the robot, the voxel A* first, else the goal's own polyline from its point
+  // nearest that start (path_from_nearest), else the fallback path.
   bool drive(const plan::ExplorationInput& in, const Goal& g, plan::ExplorationResult& r);
+
+  // start, then path's points after the one nearest start (horizontally); at least two points.
+  static std::vector<Eigen::Vector3d> path_from_nearest(const std::vector<Eigen::Vector3d>& path,
+                                                        const Eigen::Vector3d& start);
 
   bool set_aside(const Eigen::Vector3d& key_m) const;
   bool set_aside(const Goal& g) const;  // its key or its standing point
