@@ -40,6 +40,11 @@ World corridor_along_x(float half_length) {
   return w;
 }
 
+// corridor_along_x(6) scanned from its middle and 3 m along it.
+void scan_corridor(map::TraversabilityMap& m) {
+  scan(m, corridor_along_x(6), {{0, 0, 0.5f}, {3, 0, 0.5f}}, 6.0f);
+}
+
 plan::ExplorationInput input_at(const map::MapView& view, const Eigen::Vector3d& foot) {
   plan::ExplorationInput in;
   in.view = &view;
@@ -262,9 +267,8 @@ TEST(TareLike, PlansFromTheLargestPartOfItsGraphNearTheRobot) {
 // GoalDriver's fallback path (tare-like: its own viewpoint graph) is taken only where the voxel
 // A* finds no path, and the trajectory then follows it.
 TEST(GoalDriver, FallbackPathOnlyWhereTheVoxelAStarFails) {
-  const World w = corridor_along_x(6);
   map::TraversabilityMap m;
-  scan(m, w, {{0, 0, 0.5f}, {3, 0, 0.5f}}, 6.0f);
+  scan_corridor(m);
   const map::MapView view = m.view();
   const plan::ExplorationInput in = input_at(view, {0, 0, 0});
   GoalDriver d(RobotModel{}, plan::PlanOptions{}, 0.1, BaselineOptions{});
@@ -342,9 +346,8 @@ TEST(GoalDriver, KeepEndsWhenTheMapNowBlocksTheTrajectory) {
 // set_approach_frontier: a viewpoint reached while its frontier is still a goal sends the robot
 // onto the frontier once; reached there and still a goal, it is set aside.
 TEST(GoalDriver, WalksOntoAFrontierStillThereFromItsViewpoint) {
-  const World w = corridor_along_x(6);
   map::TraversabilityMap m;
-  scan(m, w, {{0, 0, 0.5f}, {3, 0, 0.5f}}, 6.0f);
+  scan_corridor(m);
   const map::MapView view = m.view();
   for (const bool approach : {true, false}) {
     // Its viewpoint at x = 0.5, the frontier itself at x = 2.5.
@@ -374,9 +377,8 @@ TEST(GoalDriver, WalksOntoAFrontierStillThereFromItsViewpoint) {
 // target, replanning to it every replan_period_s, sets it aside after no_progress_s and steps
 // away (tare-like stood wedged at a maze corner from 600 s to the limit, maze seed 2).
 TEST(GoalDriver, SetsAsideATargetItMakesNoProgressTo) {
-  const World w = corridor_along_x(6);
   map::TraversabilityMap m;
-  scan(m, w, {{0, 0, 0.5f}, {3, 0, 0.5f}}, 6.0f);
+  scan_corridor(m);
   const map::MapView view = m.view();
   for (const double no_progress_s : {10.0, 0.0}) {
     plan::PlanOptions po;
@@ -456,9 +458,8 @@ TEST(GoalDriver, DrivesFromAStartWithNoGroundSeenUnderIt) {
 // A moving robot's new trajectory starts where it comes to rest braking straight (as the local
 // layer's plan.brake_start), not at its foot: from there the body overshot the start and swung.
 TEST(GoalDriver, AMovingRobotsTrajectoryStartsWhereItComesToRest) {
-  const World w = corridor_along_x(6);
   map::TraversabilityMap m;
-  scan(m, w, {{0, 0, 0.5f}, {3, 0, 0.5f}}, 6.0f);
+  scan_corridor(m);
   const map::MapView view = m.view();
   Goal g;
   g.p_m = g.key_m = {3, 0, 0};
@@ -480,9 +481,8 @@ TEST(GoalDriver, AMovingRobotsTrajectoryStartsWhereItComesToRest) {
 // seed 4 set 18 goals aside so and ended at 244 s). The goal's own path is followed from its point
 // nearest the start.
 TEST(GoalDriver, AMovingRobotFollowsTheGoalsOwnPathWhereTheVoxelAStarFails) {
-  const World w = corridor_along_x(6);
   map::TraversabilityMap m;
-  scan(m, w, {{0, 0, 0.5f}, {3, 0, 0.5f}}, 6.0f);
+  scan_corridor(m);
   const map::MapView view = m.view();
   Goal g;
   g.p_m = g.key_m = {3, 0, 1.5};  // no support under it: the voxel A* fails

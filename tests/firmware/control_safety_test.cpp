@@ -299,6 +299,14 @@ TEST(ControlLaw, TheReferenceIsNoFasterThanTheRobotCanFollow) {
 // safety.check_body_turn (office seed 2, session 40): a body 0.3 m ahead of a new trajectory's
 // start, beside a door jamb, turns 0.6 rad towards the reference's yaw mostly where it stands.
 // The reference's own pose is clear of the jamb; the body's turn is not.
+// A door jamb along +x 0.3 m to the left of a body at the origin (0.1 m voxels, 0.2-0.4 m up).
+std::vector<Eigen::Vector3f> jamb_left_of_origin() {
+  std::vector<Eigen::Vector3f> jamb;
+  for (float x = 0.25f; x < 0.6f; x += 0.1f)
+    for (float z = 0.25f; z < 0.4f; z += 0.1f) jamb.emplace_back(x, 0.3f, z);
+  return jamb;
+}
+
 TEST(ControlLaw, TheBodysTurnTowardsItsReferenceIsSweptWhereTheBodyIs) {
   core::RobotModel robot;
   ControlLaw law(robot);
@@ -323,10 +331,7 @@ TEST(ControlLaw, TheBodysTurnTowardsItsReferenceIsSweptWhereTheBodyIs) {
   EXPECT_LT(poses[2].foot_m.x(), 0.0);
   EXPECT_GT(poses[2].foot_m.x(), -0.15);  // half turned, under half way
 
-  // A jamb along +x 0.3 m to the body's left (0.1 m voxels, 0.2-0.4 m up).
-  std::vector<Eigen::Vector3f> jamb;
-  for (float x = 0.25f; x < 0.6f; x += 0.1f)
-    for (float z = 0.25f; z < 0.4f; z += 0.1f) jamb.emplace_back(x, 0.3f, z);
+  const std::vector<Eigen::Vector3f> jamb = jamb_left_of_origin();
   core::plan::CollisionChecker checker(robot, 0.1);
   const core::plan::BodyPose here{pose.position(), 0.0, 0.0, 12.0};
   const core::plan::BodyPose at_ref{ref.p_m, ref.yaw_rad, 0.0, 12.0};
@@ -364,9 +369,7 @@ TEST(ControlLaw, ABodyWhoseTurnWouldSweepAJambSlidesOntoItsReferenceAndTurnsTher
 
   // The jamb the proportional turn sweeps (TheBodysTurnTowardsItsReferenceIsSweptWhereTheBodyIs)
   // is clear of the slide and of the turn on the reference.
-  std::vector<Eigen::Vector3f> jamb;
-  for (float x = 0.25f; x < 0.6f; x += 0.1f)
-    for (float z = 0.25f; z < 0.4f; z += 0.1f) jamb.emplace_back(x, 0.3f, z);
+  const std::vector<Eigen::Vector3f> jamb = jamb_left_of_origin();
   core::plan::CollisionChecker checker(robot, 0.1);
   std::vector<core::plan::BodyPose> turn;
   law.turn_poses(ref, pose, turn);
