@@ -296,9 +296,6 @@ TEST(ControlLaw, TheReferenceIsNoFasterThanTheRobotCanFollow) {
   EXPECT_LT(held, 0.03);
 }
 
-// safety.check_body_turn (office seed 2, session 40): a body 0.3 m ahead of a new trajectory's
-// start, beside a door jamb, turns 0.6 rad towards the reference's yaw mostly where it stands.
-// The reference's own pose is clear of the jamb; the body's turn is not.
 // A door jamb along +x 0.3 m to the left of a body at the origin (0.1 m voxels, 0.2-0.4 m up).
 std::vector<Eigen::Vector3f> jamb_left_of_origin() {
   std::vector<Eigen::Vector3f> jamb;
@@ -307,6 +304,9 @@ std::vector<Eigen::Vector3f> jamb_left_of_origin() {
   return jamb;
 }
 
+// safety.check_body_turn (office seed 2, session 40): a body 0.3 m ahead of a new trajectory's
+// start, beside a door jamb, turns 0.6 rad towards the reference's yaw mostly where it stands.
+// The reference's own pose is clear of the jamb; the body's turn is not.
 TEST(ControlLaw, TheBodysTurnTowardsItsReferenceIsSweptWhereTheBodyIs) {
   core::RobotModel robot;
   ControlLaw law(robot);
@@ -347,6 +347,8 @@ TEST(ControlLaw, TheBodysTurnTowardsItsReferenceIsSweptWhereTheBodyIs) {
   EXPECT_NEAR(poses.back().yaw_rad, -0.16, 1e-12);
 }
 
+// safety.check_body_turn's answer (session 42): where the proportional turn would sweep the jamb,
+// the body slides onto its reference at its own yaw and turns there.
 TEST(ControlLaw, ABodyWhoseTurnWouldSweepAJambSlidesOntoItsReferenceAndTurnsThere) {
   core::RobotModel robot;
   ControlLaw law(robot);
