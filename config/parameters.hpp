@@ -78,8 +78,9 @@ struct SafetyConfig {
   // Session 13 switches, off in the structs (docs/RESULTS.md session 13): each fixes a failure it
   // was measured on, and each moved which seeds end with a floor unreached. config/default.yaml
   // turns both on (lookahead_on_plan_grid since session 18, turn_on_reference since 41).
-  // Turn only where the robot will come to rest on the reference (ControlLaw::on_reference): a
-  // robot overshooting a new trajectory's start turned its body into a door frame.
+  // Turn only where the robot will come to rest on the reference or on the path it came along
+  // (ControlLaw::yaw_gate): a robot overshooting a new trajectory's start turned its body into a
+  // door frame.
   bool turn_on_reference = false;
   // The look-ahead samples the poses of the planner's own check (check_on_grid) and asks for a
   // replan on every new trajectory it finds colliding: sampled from tau, it failed a pose the

@@ -69,8 +69,7 @@ Autonomy::Autonomy(Platform& platform, const rt::Clock& clock, AutonomyOptions o
       rng_(opt_.seed),
       policy_(make_exploration_policy(opt_.method, opt_.params)),
       plan_q_(64),
-      law_(opt_.params.robot,
-           ControlGains{.turn_on_reference = opt_.params.safety.turn_on_reference}),
+      law_(opt_.params.robot),
       safety_(opt_.params.safety),
       lookahead_(opt_.params.robot, opt_.params.map.voxel_size_m),
       stop_q_(256) {
@@ -633,9 +632,13 @@ void Autonomy::control_step() {
 
   VelocityCommand cmd;
   if (!d.stop && following) {
-    entering_ = entering_ && law_.on_reference(ref, last_pose_) < 1.0;
+    double yaw_scale = 1.0;
+    if (entering_ && opt_.params.safety.turn_on_reference) {
+      yaw_scale = law_.yaw_gate(ctl_traj_->trajectory, std::min(tau_, tau_end), ref, last_pose_);
+      entering_ = yaw_scale < 1.0;
+    }
     hold_turn_ = hold_turn_ && err > ControlLaw::kSlideStepM;  // on it: the turn was checked
-    cmd = law_.track(ref, last_pose_, prev_cmd_, dt, entering_, hold_turn_);
+    cmd = law_.track(ref, last_pose_, prev_cmd_, dt, hold_turn_ ? 0.0 : yaw_scale);
     // Progress along the curve only while tracking well: after a stop or a lag the reference
     // waits for the robot instead of running away from it.
     const double rate = ControlLaw::progress_rate(err, wrap_angle(ref.yaw_rad - last_pose_.yaw_rad),

@@ -12,8 +12,8 @@ double wrap_angle(double a) {
 }
 
 VelocityCommand ControlLaw::track(const core::plan::TrajectorySample& ref, const PoseSample& pose,
-                                  const VelocityCommand& prev, double dt_s, bool entering,
-                                  bool hold_yaw) const {
+                                  const VelocityCommand& prev, double dt_s,
+                                  double yaw_scale) const {
   // World-frame planar velocity: feedforward + P on the position error.
   const double wx = ref.v_mps.x() + gains_.k_position * (ref.p_m.x() - pose.x_m);
   const double wy = ref.v_mps.y() + gains_.k_position * (ref.p_m.y() - pose.y_m);
@@ -21,10 +21,8 @@ VelocityCommand ControlLaw::track(const core::plan::TrajectorySample& ref, const
   VelocityCommand cmd;
   cmd.vx_mps = c * wx + s * wy;  // rotate into the body frame
   cmd.vy_mps = -s * wx + c * wy;
-  cmd.yaw_rate_rps = (hold_yaw                               ? 0.0
-                      : gains_.turn_on_reference && entering ? on_reference(ref, pose)
-                                                             : 1.0) *
-                     (ref.yaw_rate_rps + gains_.k_yaw * wrap_angle(ref.yaw_rad - pose.yaw_rad));
+  cmd.yaw_rate_rps =
+      yaw_scale * (ref.yaw_rate_rps + gains_.k_yaw * wrap_angle(ref.yaw_rad - pose.yaw_rad));
   return limit(cmd, prev, dt_s);
 }
 
@@ -96,6 +94,25 @@ double ControlLaw::on_reference(const core::plan::TrajectorySample& ref,
                                 const PoseSample& pose) const {
   const double g = std::clamp((0.3 - braking_gap(ref, pose)) / 0.15, 0.0, 1.0);
   return std::isfinite(g) ? g : 0.0;
+}
+
+double ControlLaw::on_path(const core::plan::BsplineTrajectory& t, double from_s, double to_s,
+                           const PoseSample& pose) const {
+  if (t.empty()) return 0.0;
+  const Eigen::Vector2d rest = rest_point(pose);
+  from_s = std::max(from_s, t.t_start());
+  to_s = std::min(to_s, t.t_end());
+  double d = std::numeric_limits<double>::infinity();
+  for (double s = from_s; s <= to_s + 1e-9; s += kPathStepS)
+    d = std::min(d, (t.sample(s).p_m.head<2>() - rest).norm());
+  const double g = std::clamp((0.3 - d) / 0.15, 0.0, 1.0);
+  return std::isfinite(g) ? g : 0.0;
+}
+
+double ControlLaw::yaw_gate(const core::plan::BsplineTrajectory& t, double tau,
+                            const core::plan::TrajectorySample& ref, const PoseSample& pose) const {
+  const double g = on_reference(ref, pose);
+  return g >= 1.0 ? g : std::max(g, on_path(t, tau - 2.0, tau, pose));
 }
 
 double ControlLaw::braking_gap(const core::plan::TrajectorySample& ref,

@@ -12,9 +12,8 @@
 namespace storey::firmware {
 
 struct ControlGains {
-  double k_position = 1.2;         // [1/s] position error -> world velocity correction
-  double k_yaw = 2.0;              // [1/s] yaw error -> yaw rate correction
-  bool turn_on_reference = false;  // scale the yaw command by on_reference() (safety config)
+  double k_position = 1.2;  // [1/s] position error -> world velocity correction
+  double k_yaw = 2.0;       // [1/s] yaw error -> yaw rate correction
 };
 
 class ControlLaw {
@@ -23,20 +22,32 @@ class ControlLaw {
       : robot_(robot), gains_(gains) {}
   // ref: the trajectory sample for now; pose: odometry; prev: the last command sent; dt_s: the
   // control period (bounds the change of the command by the acceleration limits).
-  // With ControlGains::turn_on_reference the yaw command is scaled by on_reference() while
-  // `entering` a new trajectory (until the robot first came to be on it): the robot turns only
-  // where it will come to rest on the reference. Once on it, full yaw authority (a robot lagging
-  // its reference on a flight, the gate held the yaw off the axis and the climbs failed).
-  // hold_yaw: no yaw command (safety.check_body_turn: the body slides onto its reference first).
+  // yaw_scale [0, 1] scales the yaw command: safety.turn_on_reference's gate while entering a
+  // new trajectory (yaw_gate), 0 while safety.check_body_turn slides the body onto its reference.
   VelocityCommand track(const core::plan::TrajectorySample& ref, const PoseSample& pose,
-                        const VelocityCommand& prev, double dt_s, bool entering = true,
-                        bool hold_yaw = false) const;
+                        const VelocityCommand& prev, double dt_s, double yaw_scale = 1.0) const;
+  // safety.turn_on_reference: the yaw authority [0, 1] of a robot entering trajectory t (until it
+  // first came to be on it), reference at tau: the larger of on_reference() and on_path() over
+  // the last 2 s of t before tau. The robot turns only where it will come to rest on the
+  // trajectory. Once on it, full yaw authority (a robot lagging its reference on a flight, the
+  // gate held the yaw off the axis and the climbs failed).
+  double yaw_gate(const core::plan::BsplineTrajectory& t, double tau,
+                  const core::plan::TrajectorySample& ref, const PoseSample& pose) const;
   // 1 while the point where the robot would stop if it braked now is within 0.15 m of the
   // reference's, falling to 0 at 0.3 m. A new trajectory starts at rest where the robot was when
   // it was planned; a robot arriving at walking speed overshoots that start by up to
   // v^2 / (2 a_max) (0.5 m at 1 m/s) before it is back, and turning the 0.7 m body there, off
   // the poses FCL checked, swept it into a door frame (teaching_building seed 1, 842 s).
   double on_reference(const core::plan::TrajectorySample& ref, const PoseSample& pose) const;
+  // The same ramp for the distance from the robot's rest point to t's path between from_s and
+  // to_s (sampled every kPathStepS). A body entering a trajectory mid-way from rest (ControlLaw::
+  // entry_time) lags a reference at walking speed by up to 0.3 m (progress_rate) and never comes
+  // to rest at it, so on_reference alone held its yaw off the path's for good: it met a jamb
+  // turning late (office, nearest-frontier seed 5, 184 s). Where it rests on the path, the path's
+  // poses were checked.
+  double on_path(const core::plan::BsplineTrajectory& t, double from_s, double to_s,
+                 const PoseSample& pose) const;
+  static constexpr double kPathStepS = 0.05;
   // Where the robot comes to rest if it brakes now at a_max, world frame [m] (planar).
   Eigen::Vector2d rest_point(const PoseSample& pose) const;
   // Where on a new trajectory tracking starts: its point nearest `at` (the robot) within its first

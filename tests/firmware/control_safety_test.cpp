@@ -53,7 +53,7 @@ TEST(ControlLaw, ClampsSpeedYawRateAndAcceleration) {
 // at 0.95 m/s (teaching_building seed 1, 842 s): the robot brakes and comes back before it turns.
 TEST(ControlLaw, TurnsOnlyWhereItWillComeToRestOnTheReference) {
   core::RobotModel robot;
-  ControlLaw law(robot, ControlGains{.turn_on_reference = true});
+  ControlLaw law(robot);
   const auto start = ref_at(0, 0, 0, 0, 1.5);  // the new trajectory's start: turn left in place
   PoseSample pose;
   pose.vx_mps = 0.95;  // walking +x past it
@@ -64,7 +64,7 @@ TEST(ControlLaw, TurnsOnlyWhereItWillComeToRestOnTheReference) {
   const double dt = 0.02;
   double max_x = 0, yaw_when_far = 0;
   for (int i = 0; i < 400; ++i) {
-    const VelocityCommand c = law.track(start, pose, prev, dt);
+    const VelocityCommand c = law.track(start, pose, prev, dt, law.on_reference(start, pose));
     pose.x_m += dt * (std::cos(pose.yaw_rad) * c.vx_mps - std::sin(pose.yaw_rad) * c.vy_mps);
     pose.y_m += dt * (std::sin(pose.yaw_rad) * c.vx_mps + std::cos(pose.yaw_rad) * c.vy_mps);
     pose.yaw_rad += dt * c.yaw_rate_rps;
@@ -85,8 +85,52 @@ TEST(ControlLaw, TurnsOnlyWhereItWillComeToRestOnTheReference) {
   // (on a flight the robot trails its reference; gated, it drifted off the axis).
   PoseSample lagging;
   lagging.x_m = -0.5;
-  EXPECT_EQ(law.track(start, lagging, VelocityCommand{}, dt, true).yaw_rate_rps, 0.0);
-  EXPECT_GT(law.track(start, lagging, VelocityCommand{}, dt, false).yaw_rate_rps, 0.0);
+  EXPECT_EQ(law.track(start, lagging, VelocityCommand{}, dt, law.on_reference(start, lagging))
+                .yaw_rate_rps,
+            0.0);
+  EXPECT_GT(law.track(start, lagging, VelocityCommand{}, dt).yaw_rate_rps, 0.0);
+}
+
+// A body entering a trajectory mid-way from rest (ControlLaw::entry_time) lags a reference at
+// walking speed and never comes to rest at it: on_reference alone held its yaw 16 deg off the
+// path's until it met a jamb (office, nearest-frontier seed 5, 184 s). Where it rests on the path
+// the gate opens; a body overshooting the start of a path that turns away is still gated.
+TEST(ControlLaw, ABodyLaggingItsReferenceOnThePathTurns) {
+  core::RobotModel robot;
+  ControlLaw law(robot);
+  // Along +x from rest at x = 0, 1 s per knot, to x = 3, heading +x.
+  std::vector<Eigen::Vector3d> ctrl;
+  for (double x : {0.0, 0.0, 0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 3.0, 3.0})
+    ctrl.emplace_back(x, 0.0, 0.0);
+  const core::plan::BsplineTrajectory t(ctrl, std::vector<double>(ctrl.size(), 0.0), 1.0, 10.0);
+  const double tau = 13.0;  // at x = 1, 0.5 m/s
+  const core::plan::TrajectorySample ref = t.sample(tau);
+  ASSERT_GT(ref.v_mps.x(), 0.4);
+  PoseSample pose;  // at rest on the path, 0.28 m behind the reference, 0.3 rad off its yaw
+  pose.x_m = ref.p_m.x() - 0.28;
+  pose.yaw_rad = -0.3;
+  EXPECT_EQ(law.on_reference(ref, pose), 0.0);
+  EXPECT_EQ(law.on_path(t, tau - 2.0, tau, pose), 1.0);
+  EXPECT_EQ(law.yaw_gate(t, tau, ref, pose), 1.0);
+  EXPECT_GT(
+      law.track(ref, pose, VelocityCommand{}, 0.02, law.yaw_gate(t, tau, ref, pose)).yaw_rate_rps,
+      0.0);
+  // 0.25 m beside the path: the ramp from 0.15 m to 0.3 m.
+  pose.y_m = 0.25;
+  EXPECT_NEAR(law.on_path(t, tau - 2.0, tau, pose), 1.0 / 3.0, 1e-3);
+  // Only the path the reference has come along within the window counts: the same body ahead
+  // of a reference that just left the start is off it.
+  pose.y_m = 0.0;
+  EXPECT_EQ(law.on_path(t, 8.0, 10.5, pose), 0.0);
+  // Walking at 0.95 m/s past the start of a path that turns away (+y): the rest point is off
+  // the path, no yaw.
+  std::vector<Eigen::Vector3d> side;
+  for (double y : {0.0, 0.0, 0.0, 0.5, 1.0, 1.0, 1.0}) side.emplace_back(0.0, y, 0.0);
+  const core::plan::BsplineTrajectory u(side, std::vector<double>(side.size(), M_PI / 2), 1.0, 0.0);
+  PoseSample walking;
+  walking.vx_mps = 0.95;
+  EXPECT_EQ(law.yaw_gate(u, 0.0, u.sample(0.0), walking), 0.0);
+  EXPECT_EQ(law.on_path(core::plan::BsplineTrajectory{}, 0.0, 1.0, walking), 0.0);
 }
 
 // plan.brake_start: the planner starts a moving robot's new trajectory where it comes to rest.
@@ -379,10 +423,10 @@ TEST(ControlLaw, ABodyWhoseTurnWouldSweepAJambSlidesOntoItsReferenceAndTurnsTher
   EXPECT_FALSE(checker.check_poses(poses, jamb).collides);
 
   // While it slides no yaw is commanded; the position is still tracked.
-  const VelocityCommand held = law.track(ref, pose, VelocityCommand{}, 0.02, false, true);
+  const VelocityCommand held = law.track(ref, pose, VelocityCommand{}, 0.02, 0.0);
   EXPECT_EQ(held.yaw_rate_rps, 0.0);
   EXPECT_LT(held.vx_mps, 0.0);
-  EXPECT_GT(law.track(ref, pose, VelocityCommand{}, 0.02, false, false).yaw_rate_rps, 0.0);
+  EXPECT_GT(law.track(ref, pose, VelocityCommand{}, 0.02).yaw_rate_rps, 0.0);
 
   // Nothing to slide: under kTurnMinRad off, or further off than kSlideMaxM (the reference waits
   // for the robot from 0.6 m), or a non-finite reference.
