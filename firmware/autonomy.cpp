@@ -499,6 +499,7 @@ void Autonomy::control_step() {
     if (ctl_traj_ && !ctl_traj_->trajectory.empty())
       tau_ = ControlLaw::entry_time(ctl_traj_->trajectory,
                                     Eigen::Vector2d(last_pose_.x_m, last_pose_.y_m));
+    entry_tau_ = tau_;
     lag_s_ = std::max(0.0, now - tau_);  // entered late (braking first, the plan's latency)
   };
   const auto tv = traj_.read();
@@ -634,7 +635,8 @@ void Autonomy::control_step() {
   if (!d.stop && following) {
     double yaw_scale = 1.0;
     if (entering_ && opt_.params.safety.turn_on_reference) {
-      yaw_scale = law_.yaw_gate(ctl_traj_->trajectory, std::min(tau_, tau_end), ref, last_pose_);
+      yaw_scale = law_.yaw_gate(ctl_traj_->trajectory, entry_tau_, std::min(tau_, tau_end), ref,
+                                last_pose_);
       entering_ = yaw_scale < 1.0;
     }
     hold_turn_ = hold_turn_ && err > ControlLaw::kSlideStepM;  // on it: the turn was checked

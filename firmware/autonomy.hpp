@@ -290,8 +290,9 @@ class Autonomy {
   std::vector<core::plan::BodyPose> turn_poses_;  // safety.check_body_turn (ControlLaw::turn_poses)
   uint64_t ctl_traj_version_ = 0, ctl_checked_traj_ = 0, ctl_checked_map_ = 0;
   std::shared_ptr<const PlannedTrajectory> ctl_traj_;
-  double tau_ = 0;    // progress along the trajectory [s] (advances while tracking well)
-  double lag_s_ = 0;  // now - tau_ while tau_ runs (TrajectoryProgress)
+  double tau_ = 0;        // progress along the trajectory [s] (advances while tracking well)
+  double entry_tau_ = 0;  // where tracking entered it (ControlLaw::entry_time) [s]
+  double lag_s_ = 0;      // now - tau_ while tau_ runs (TrajectoryProgress)
   rt::Mailbox<TrajectoryProgress> progress_mb_;
   bool hold_turn_ = false;  // safety.check_body_turn: slide onto the reference, then turn
   bool entering_ = false;   // a new trajectory the robot has not yet been on (turn_on_reference)

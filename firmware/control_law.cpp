@@ -105,14 +105,14 @@ double ControlLaw::on_path(const core::plan::BsplineTrajectory& t, double from_s
   double d = std::numeric_limits<double>::infinity();
   for (double s = from_s; s <= to_s + 1e-9; s += kPathStepS)
     d = std::min(d, (t.sample(s).p_m.head<2>() - rest).norm());
-  const double g = std::clamp((0.3 - d) / 0.15, 0.0, 1.0);
+  const double g = std::clamp((kOnPathZeroM - d) / (kOnPathZeroM - kOnPathFullM), 0.0, 1.0);
   return std::isfinite(g) ? g : 0.0;
 }
 
-double ControlLaw::yaw_gate(const core::plan::BsplineTrajectory& t, double tau,
+double ControlLaw::yaw_gate(const core::plan::BsplineTrajectory& t, double entry_tau, double tau,
                             const core::plan::TrajectorySample& ref, const PoseSample& pose) const {
   const double g = on_reference(ref, pose);
-  return g >= 1.0 ? g : std::max(g, on_path(t, tau - 2.0, tau, pose));
+  return g >= 1.0 ? g : std::max(g, on_path(t, std::max(entry_tau, tau - 2.0), tau, pose));
 }
 
 double ControlLaw::braking_gap(const core::plan::TrajectorySample& ref,

@@ -27,11 +27,12 @@ class ControlLaw {
   VelocityCommand track(const core::plan::TrajectorySample& ref, const PoseSample& pose,
                         const VelocityCommand& prev, double dt_s, double yaw_scale = 1.0) const;
   // safety.turn_on_reference: the yaw authority [0, 1] of a robot entering trajectory t (until it
-  // first came to be on it), reference at tau: the larger of on_reference() and on_path() over
-  // the last 2 s of t before tau. The robot turns only where it will come to rest on the
-  // trajectory. Once on it, full yaw authority (a robot lagging its reference on a flight, the
-  // gate held the yaw off the axis and the climbs failed).
-  double yaw_gate(const core::plan::BsplineTrajectory& t, double tau,
+  // first came to be on it) at entry_tau (ControlLaw::entry_time), reference at tau: the larger
+  // of on_reference() and on_path() over the path the reference came along, from entry_tau, at
+  // most 2 s back from tau (the path before the entry was never the reference). The robot turns
+  // only where it will come to rest on the trajectory. Once on it, full yaw authority (a robot
+  // lagging its reference on a flight, the gate held the yaw off the axis and the climbs failed).
+  double yaw_gate(const core::plan::BsplineTrajectory& t, double entry_tau, double tau,
                   const core::plan::TrajectorySample& ref, const PoseSample& pose) const;
   // 1 while the point where the robot would stop if it braked now is within 0.15 m of the
   // reference's, falling to 0 at 0.3 m. A new trajectory starts at rest where the robot was when
@@ -39,15 +40,17 @@ class ControlLaw {
   // v^2 / (2 a_max) (0.5 m at 1 m/s) before it is back, and turning the 0.7 m body there, off
   // the poses FCL checked, swept it into a door frame (teaching_building seed 1, 842 s).
   double on_reference(const core::plan::TrajectorySample& ref, const PoseSample& pose) const;
-  // The same ramp for the distance from the robot's rest point to t's path between from_s and
-  // to_s (sampled every kPathStepS). A body entering a trajectory mid-way from rest (ControlLaw::
-  // entry_time) lags a reference at walking speed by up to 0.3 m (progress_rate) and never comes
-  // to rest at it, so on_reference alone held its yaw off the path's for good: it met a jamb
-  // turning late (office, nearest-frontier seed 5, 184 s). Where it rests on the path, the path's
-  // poses were checked.
+  // 1 while the robot's rest point is within kOnPathFullM of t's path between from_s and to_s
+  // (sampled every kPathStepS), falling to 0 at kOnPathZeroM. A body entering a trajectory
+  // mid-way from rest (ControlLaw::entry_time) lags a reference at walking speed by up to 0.3 m
+  // (progress_rate) and never comes to rest at it, so on_reference alone held its yaw off the
+  // path's for good: it met a jamb turning late (office, nearest-frontier seed 5, 184 s). Where
+  // it rests on the path, the path's poses were checked. A tighter ramp than on_reference's: with
+  // the same, a body coming back from overshooting a trajectory's start turned 0.35 m off it
+  // (the start is nearer than the reference) into a wall (teaching building seed 2, 533.9 s).
   double on_path(const core::plan::BsplineTrajectory& t, double from_s, double to_s,
                  const PoseSample& pose) const;
-  static constexpr double kPathStepS = 0.05;
+  static constexpr double kPathStepS = 0.05, kOnPathFullM = 0.05, kOnPathZeroM = 0.15;
   // Where the robot comes to rest if it brakes now at a_max, world frame [m] (planar).
   Eigen::Vector2d rest_point(const PoseSample& pose) const;
   // Where on a new trajectory tracking starts: its point nearest `at` (the robot) within its first

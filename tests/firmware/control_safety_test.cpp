@@ -94,7 +94,9 @@ TEST(ControlLaw, TurnsOnlyWhereItWillComeToRestOnTheReference) {
 // A body entering a trajectory mid-way from rest (ControlLaw::entry_time) lags a reference at
 // walking speed and never comes to rest at it: on_reference alone held its yaw 16 deg off the
 // path's until it met a jamb (office, nearest-frontier seed 5, 184 s). Where it rests on the path
-// the gate opens; a body overshooting the start of a path that turns away is still gated.
+// the gate opens; a body overshooting the start of a path that turns away, or coming back from
+// it 0.2 m off (teaching building seed 2, 533.9 s: gated by the ramp on_reference uses, it
+// turned into a wall), is still gated.
 TEST(ControlLaw, ABodyLaggingItsReferenceOnThePathTurns) {
   core::RobotModel robot;
   ControlLaw law(robot);
@@ -111,13 +113,18 @@ TEST(ControlLaw, ABodyLaggingItsReferenceOnThePathTurns) {
   pose.yaw_rad = -0.3;
   EXPECT_EQ(law.on_reference(ref, pose), 0.0);
   EXPECT_EQ(law.on_path(t, tau - 2.0, tau, pose), 1.0);
-  EXPECT_EQ(law.yaw_gate(t, tau, ref, pose), 1.0);
-  EXPECT_GT(
-      law.track(ref, pose, VelocityCommand{}, 0.02, law.yaw_gate(t, tau, ref, pose)).yaw_rate_rps,
-      0.0);
-  // 0.25 m beside the path: the ramp from 0.15 m to 0.3 m.
-  pose.y_m = 0.25;
-  EXPECT_NEAR(law.on_path(t, tau - 2.0, tau, pose), 1.0 / 3.0, 1e-3);
+  EXPECT_EQ(law.yaw_gate(t, 12.0, tau, ref, pose), 1.0);  // entered at x = 0.5
+  EXPECT_GT(law.track(ref, pose, VelocityCommand{}, 0.02, law.yaw_gate(t, 12.0, tau, ref, pose))
+                .yaw_rate_rps,
+            0.0);
+  // Not the path before the entry, which the reference never came along: entered at tau
+  // itself, the body 0.28 m behind it is still gated.
+  EXPECT_LT(law.yaw_gate(t, tau, tau, ref, pose), 0.2);
+  // Beside the path: the ramp from 0.05 m to 0.15 m, tighter than on_reference's.
+  pose.y_m = 0.1;
+  EXPECT_NEAR(law.on_path(t, tau - 2.0, tau, pose), 0.5, 0.01);  // sampled path
+  pose.y_m = 0.2;
+  EXPECT_EQ(law.on_path(t, tau - 2.0, tau, pose), 0.0);
   // Only the path the reference has come along within the window counts: the same body ahead
   // of a reference that just left the start is off it.
   pose.y_m = 0.0;
@@ -129,7 +136,7 @@ TEST(ControlLaw, ABodyLaggingItsReferenceOnThePathTurns) {
   const core::plan::BsplineTrajectory u(side, std::vector<double>(side.size(), M_PI / 2), 1.0, 0.0);
   PoseSample walking;
   walking.vx_mps = 0.95;
-  EXPECT_EQ(law.yaw_gate(u, 0.0, u.sample(0.0), walking), 0.0);
+  EXPECT_EQ(law.yaw_gate(u, 0.0, 0.0, u.sample(0.0), walking), 0.0);
   EXPECT_EQ(law.on_path(core::plan::BsplineTrajectory{}, 0.0, 1.0, walking), 0.0);
 }
 
