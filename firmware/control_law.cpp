@@ -90,10 +90,17 @@ size_t ControlLaw::max_swept_poses() {
   return size_t(std::ceil(kSlideMaxM / kSlideStepM)) + size_t(std::ceil(M_PI / kTurnStepRad)) + 2;
 }
 
+namespace {
+// 1 up to full_m, falling linearly to 0 at zero_m; 0 for a non-finite distance.
+double ramp_down(double d, double full_m, double zero_m) {
+  const double g = std::clamp((zero_m - d) / (zero_m - full_m), 0.0, 1.0);
+  return std::isfinite(g) ? g : 0.0;
+}
+}  // namespace
+
 double ControlLaw::on_reference(const core::plan::TrajectorySample& ref,
                                 const PoseSample& pose) const {
-  const double g = std::clamp((0.3 - braking_gap(ref, pose)) / 0.15, 0.0, 1.0);
-  return std::isfinite(g) ? g : 0.0;
+  return ramp_down(braking_gap(ref, pose), 0.15, 0.3);
 }
 
 double ControlLaw::on_path(const core::plan::BsplineTrajectory& t, double from_s, double to_s,
@@ -105,8 +112,7 @@ double ControlLaw::on_path(const core::plan::BsplineTrajectory& t, double from_s
   double d = std::numeric_limits<double>::infinity();
   for (double s = from_s; s <= to_s + 1e-9; s += kPathStepS)
     d = std::min(d, (t.sample(s).p_m.head<2>() - rest).norm());
-  const double g = std::clamp((kOnPathZeroM - d) / (kOnPathZeroM - kOnPathFullM), 0.0, 1.0);
-  return std::isfinite(g) ? g : 0.0;
+  return ramp_down(d, kOnPathFullM, kOnPathZeroM);
 }
 
 double ControlLaw::yaw_gate(const core::plan::BsplineTrajectory& t, double entry_tau, double tau,
