@@ -32,12 +32,36 @@ TEST(EvalOptions, ListsSeedsAndValues) {
   EXPECT_EQ(g.ablations, (std::vector<std::string>{"full", "no-c-sur"}));
   EXPECT_EQ(r.options.seeds, (std::vector<uint64_t>{1, 2, 3}));
   EXPECT_EQ(r.options.jobs, 4);
-  EXPECT_DOUBLE_EQ(r.options.time_limit_s, 60.5);
+  // A number replaces every scene's limit, the teaching building's default included.
+  EXPECT_DOUBLE_EQ(r.options.time_limits.for_scene("maze"), 60.5);
+  EXPECT_DOUBLE_EQ(r.options.time_limits.for_scene("teaching_building"), 60.5);
   EXPECT_EQ(r.options.out_dir, "x/y");
   EXPECT_EQ(r.options.storey, "/bin/true");
   EXPECT_EQ(r.options.config, "c.yaml");
   // A list is exactly those seeds (duplicates once).
   EXPECT_EQ(parse({"--seeds", "7,3,7"}).options.seeds, (std::vector<uint64_t>{7, 3}));
+}
+
+TEST(EvalOptions, TimeLimitsPerScene) {
+  // Default: 1800 s, the teaching building 3000 s (our robot needs ~2000 s there).
+  const TimeLimits d = parse({}).options.time_limits;
+  EXPECT_DOUBLE_EQ(d.for_scene("maze"), 1800);
+  EXPECT_DOUBLE_EQ(d.for_scene("teaching_building"), 3000);
+  // SCENE=S on top of the defaults, in any order with the number.
+  const ParseResult r = parse({"--time-limit", "maze=2400,900,office=100.5"});
+  ASSERT_TRUE(r.ok()) << r.error;
+  const TimeLimits& t = r.options.time_limits;
+  EXPECT_DOUBLE_EQ(t.for_scene("maze"), 2400);
+  EXPECT_DOUBLE_EQ(t.for_scene("office"), 100.5);
+  EXPECT_DOUBLE_EQ(t.for_scene("house"), 900);
+  EXPECT_DOUBLE_EQ(t.for_scene("teaching_building"), 900);
+  EXPECT_EQ(t.describe(), "900 s, maze 2400 s, office 100.5 s");
+  const ParseResult k = parse({"--preset", "paper", "--time-limit", "maze=2400"});
+  ASSERT_TRUE(k.ok()) << k.error;
+  EXPECT_DOUBLE_EQ(k.options.time_limits.for_scene("teaching_building"), 3000);
+  EXPECT_DOUBLE_EQ(k.options.time_limits.for_scene("house"), 1800);
+  // A scene file is named by its stem, as in the run folders.
+  EXPECT_TRUE(parse({"--scenes", "x/hall.yaml", "--time-limit", "hall=5"}).ok());
 }
 
 TEST(EvalOptions, ErrorsNameTheFlag) {
@@ -53,6 +77,10 @@ TEST(EvalOptions, ErrorsNameTheFlag) {
       {{"--jobs", "-2"}, "--jobs -2:"},
       {{"--time-limit", "-5"}, "--time-limit -5:"},
       {{"--time-limit", "nan"}, "--time-limit nan:"},
+      {{"--time-limit", "600,700"}, "--time-limit 600,700: two limits"},
+      {{"--time-limit", "maze="}, "--time-limit maze=:"},
+      {{"--time-limit", "a b=5"}, "--time-limit a b=5: bad scene name"},
+      {{"--scenes", "maze", "--time-limit", "office=900"}, "--time-limit: scene 'office' is not"},
       {{"--preset", "everything"}, "--preset everything:"},
       {{"--methods", "storey,../../etc"}, "--methods storey,../../etc:"},
       {{"--ablations", "a b"}, "--ablations a b:"},

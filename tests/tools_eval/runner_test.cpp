@@ -25,13 +25,14 @@ struct FakeStorey {
     calls = dir + "/calls.txt";
     std::ofstream f(script);
     f << "#!/bin/sh\n"
-         "out=''; seed=''; method=''; ablation=full\n"
+         "out=''; seed=''; method=''; ablation=full; limit=''\n"
          "while [ $# -gt 0 ]; do case \"$1\" in --out) out=$2; shift;; --seed) seed=$2; shift;;\n"
+         "  --time-limit) limit=$2; shift;;\n"
          "  --method) method=$2; shift;; --ablation) ablation=$2; shift;; esac; shift; done\n"
          "echo \"$method $ablation $seed\" >> '"
       << calls
       << "'\n"
-         "echo 'storey sim: scene x, seed' $seed >&2\n"
+         "echo 'storey sim: scene x, seed' $seed, time limit $limit >&2\n"
          "if [ \"$method\" = refused ]; then\n"
          "  echo 'storey sim: --method refused: not available yet' >&2; exit 2; fi\n"
          "if [ \"$method\" = crash ]; then kill -SEGV $$; fi\n"
@@ -60,7 +61,7 @@ struct FakeStorey {
     return v;
   }
   Runner runner(const std::string& out, int jobs = 2) const {
-    return Runner({script, jobs, out, 30, "", nullptr});
+    return Runner({script, jobs, out, TimeLimits{30, {}}, "", nullptr});
   }
 };
 
@@ -82,7 +83,8 @@ TEST(Runner, RunsEverySpecAndRecordsFailuresWithTheirReason) {
     std::ifstream log(dir + "/log.txt");
     std::stringstream ss;
     ss << log.rdbuf();
-    EXPECT_NE(ss.str().find("storey sim: scene x, seed " + std::to_string(i + 1)),
+    EXPECT_NE(ss.str().find("storey sim: scene x, seed " + std::to_string(i + 1) +
+                            ", time limit 30"),
               std::string::npos);
     EXPECT_TRUE(fs::exists(dir + "/eval.json"));
     EXPECT_FALSE(fs::exists(dir + ".partial"));
@@ -96,6 +98,25 @@ TEST(Runner, RunsEverySpecAndRecordsFailuresWithTheirReason) {
     EXPECT_EQ(again.status, RunStatus::failed);
     EXPECT_EQ(again.reason, res[i].reason);
   }
+}
+
+std::string log_of(const std::string& dir) {
+  std::ifstream f(dir + "/log.txt");
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+TEST(Runner, EachSceneRunsWithItsOwnTimeLimit) {
+  FakeStorey fake;
+  const std::string out = fake.dir + "/eval";
+  const auto specs = expand_matrix({{{"box", "scenes/hall.yaml"}, {"storey"}, {"full"}}}, {1});
+  const auto res =
+      Runner({fake.script, 1, out, TimeLimits{30, {{"hall", 45.5}}}, "", nullptr}).run(specs);
+  ASSERT_EQ(res.size(), 2u);
+  EXPECT_NE(log_of(out + "/" + specs[0].rel_dir()).find("time limit 30\n"), std::string::npos);
+  // Keyed by the folder name (the file's stem), as the tables name the scene.
+  EXPECT_NE(log_of(out + "/" + specs[1].rel_dir()).find("time limit 45.5\n"), std::string::npos);
 }
 
 TEST(Runner, ResumesFinishedRunsAndRetriesFailedAndBrokenOnes) {
@@ -145,7 +166,7 @@ TEST(Runner, ASignalledOrMissingChildIsAFailedRunNotAnAbort) {
   EXPECT_EQ(res[1].status, RunStatus::finished);
 
   const auto missing =
-      Runner({fake.dir + "/no-such-storey", 1, out + "2", 30, "", nullptr}).run(specs);
+      Runner({fake.dir + "/no-such-storey", 1, out + "2", TimeLimits{30, {}}, "", nullptr}).run(specs);
   EXPECT_EQ(missing[0].status, RunStatus::failed);
   EXPECT_NE(missing[0].reason.find("no-such-storey"), std::string::npos) << missing[0].reason;
 }

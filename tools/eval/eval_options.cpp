@@ -23,8 +23,8 @@ void print_eval_usage(FILE* out) {
       out,
       "usage: storey-eval [--scenes A,B,...] [--methods A,B,...] [--ablations A,B,...]\n"
       "                   [--preset tables|ablations|paper] [--seeds N|A,B,...] [--jobs N]\n"
-      "                   [--time-limit S] [--out DIR] [--storey PATH] [--config FILE]\n"
-      "                   [--report-only]\n\n"
+      "                   [--time-limit S|SCENE=S,...] [--out DIR] [--storey PATH]\n"
+      "                   [--config FILE] [--report-only]\n\n"
       "Runs `storey sim` for every scene x method x ablation x seed (in parallel, resumable)\n"
       "and writes DIR/results.md (the paper's Tables I-IV, mean +- std over seeds),\n"
       "DIR/results.csv (one row per run), DIR/results.json and DIR/coverage_<scene>.png.\n"
@@ -42,7 +42,9 @@ void print_eval_usage(FILE* out) {
       "                     Not combined with --scenes/--methods/--ablations\n"
       "  --seeds N|LIST     N: seeds 1..N (default 5); A,B,...: exactly those seeds\n"
       "  --jobs N           parallel runs (default: the machine's cores)\n"
-      "  --time-limit S     simulated seconds per run (default 1800)\n"
+      "  --time-limit LIST  simulated seconds per run: S sets every scene's (the teaching\n"
+      "                     building's default included), SCENE=S one scene's (default\n"
+      "                     1800,teaching_building=3000)\n"
       "  --out DIR          output folder (default out/eval)\n"
       "  --storey PATH      the storey executable (default: next to storey-eval)\n"
       "  --config FILE      configuration passed to every run\n"
@@ -61,6 +63,12 @@ std::vector<std::string> split_list(const std::string& v) {
     pos = comma + 1;
   }
   return out;
+}
+
+bool parse_seconds(const std::string& s, double& out) {
+  char* end = nullptr;
+  out = std::strtod(s.c_str(), &end);
+  return !s.empty() && end && *end == '\0' && std::isfinite(out) && out > 0;
 }
 
 bool parse_uint(const std::string& s, uint64_t& out) {
@@ -90,6 +98,7 @@ ParseResult parse_eval_args(const std::vector<std::string>& args) {
   bool matrix_flag = false;
   std::string matrix_flag_name;
   bool seeds_given = false;
+  std::vector<std::string> limit_scenes;  // scenes named in --time-limit
   auto fail = [&](const std::string& msg) {
     r.error = msg;
     return r;
@@ -146,11 +155,30 @@ ParseResult parse_eval_args(const std::vector<std::string>& args) {
         return fail("--jobs " + v + ": expected an integer 1..1024");
       o.jobs = int(n);
     } else if (a == "--time-limit") {
-      char* end = nullptr;
-      const double d = std::strtod(v.c_str(), &end);
-      if (v.empty() || !end || *end != '\0' || !std::isfinite(d) || d <= 0)
-        return fail("--time-limit " + v + ": expected simulated seconds > 0");
-      o.time_limit_s = d;
+      // Numbers first (they replace every scene's limit), then SCENE=S entries on top.
+      std::vector<std::pair<std::string, double>> scenes;
+      bool all_given = false;
+      for (const auto& item : split_list(v)) {
+        const size_t eq = item.find('=');
+        const std::string name = eq == std::string::npos ? "" : item.substr(0, eq);
+        const std::string num = eq == std::string::npos ? item : item.substr(eq + 1);
+        double d = 0;
+        if (!parse_seconds(num, d))
+          return fail("--time-limit " + v + ": '" + item +
+                      "': expected simulated seconds > 0 or SCENE=seconds");
+        if (eq == std::string::npos) {
+          if (all_given) return fail("--time-limit " + v + ": two limits for every scene");
+          all_given = true;
+          o.time_limits.all_s = d;
+          o.time_limits.scene_s.clear();
+        } else if (!valid_name(name, false)) {
+          return fail("--time-limit " + v + ": bad scene name '" + name + "'");
+        } else {
+          scenes.emplace_back(name, d);
+          limit_scenes.push_back(name);
+        }
+      }
+      for (const auto& [name, d] : scenes) o.time_limits.scene_s[name] = d;
     } else if (a == "--out") {
       if (v.empty()) return fail("--out: empty folder name");
       o.out_dir = v;
@@ -167,10 +195,7 @@ ParseResult parse_eval_args(const std::vector<std::string>& args) {
   if (!o.presets.empty() && matrix_flag)
     return fail(matrix_flag_name +
                 ": cannot be combined with --preset (a preset fixes the matrix)");
-  if (o.presets.empty()) {
-    o.groups.push_back(flags);
-    return r;
-  }
+  if (o.presets.empty()) o.groups.push_back(flags);
   // Paper Section V: Tables I-II run every scene with every method; Tables III-IV run the
   // ablations of Groups A and B on maze with the proposed method.
   for (const auto& p : o.presets) {
@@ -183,6 +208,21 @@ ParseResult parse_eval_args(const std::vector<std::string>& args) {
           g.ablations.push_back(b);
       o.groups.push_back(g);
     }
+  }
+  // A limit for a scene the matrix does not run is a typo that would pass silently.
+  for (const auto& name : limit_scenes) {
+    bool found = false;
+    std::string known;
+    for (const auto& g : o.groups)
+      for (const auto& s : g.scenes) {
+        const std::string stem = RunSpec{s, "", "", 1}.scene_name();
+        found = found || stem == name;
+        if (!known.empty()) known += ", ";
+        known += stem;
+      }
+    if (!found)
+      return fail("--time-limit: scene '" + name + "' is not in the matrix (scenes: " + known +
+                  ")");
   }
   return r;
 }

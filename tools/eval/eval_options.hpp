@@ -1,5 +1,5 @@
 // storey-eval's command line (DESIGN §7): the matrix (flags or a preset), seeds, parallelism,
-// the simulated time limit, the output folder and where the `storey` executable is.
+// the simulated time limits, the output folder and where the `storey` executable is.
 #pragma once
 
 #include <cstdint>
@@ -15,7 +15,7 @@ struct EvalOptions {
   std::vector<std::string> presets;
   std::vector<uint64_t> seeds;       // --seeds N -> 1..N; --seeds 3,7 -> {3, 7}
   int jobs = 0;                      // 0 = the machine's cores
-  double time_limit_s = 1800;        // simulated seconds per run (Teaching Building: ~1250 s)
+  TimeLimits time_limits;            // --time-limit: simulated seconds per run, per scene
   std::string out_dir = "out/eval";  // runs/, results.md, results.csv, results.json, PNGs
   std::string storey;                // "" = the `storey` next to storey-eval
   std::string config;                // passed on as --config when set

@@ -96,9 +96,10 @@ int main(int argc, char** argv) {
     } else {
       std::fprintf(stderr,
                    "storey-eval: %zu runs (%zu scene/method/ablation x %zu seeds), %d jobs, "
-                   "%s, into %s\n",
+                   "time limit %s, %s, into %s\n",
                    specs.size(), o.seeds.empty() ? 0 : specs.size() / o.seeds.size(),
-                   o.seeds.size(), jobs, storey.c_str(), o.out_dir.c_str());
+                   o.seeds.size(), jobs, o.time_limits.describe().c_str(), storey.c_str(),
+                   o.out_dir.c_str());
       // Each run reads ./config/default.yaml when no --config is given: that file belongs to the
       // working tree, which need not be the code another --storey was built from (session 35:
       // a key added to the tree's file failed 43 runs of a binary built before it).
@@ -112,7 +113,7 @@ int main(int argc, char** argv) {
       sa.sa_flags = SA_RESETHAND;  // a second Ctrl-C kills storey-eval at once
       sigaction(SIGINT, &sa, nullptr);
       sigaction(SIGTERM, &sa, nullptr);
-      eval::Runner runner({storey, jobs, o.out_dir, o.time_limit_s, o.config, stderr});
+      eval::Runner runner({storey, jobs, o.out_dir, o.time_limits, o.config, stderr});
       outcomes = runner.run(specs);
     }
     const auto files = eval::write_results(o.out_dir, outcomes, shell_words(argc, argv));

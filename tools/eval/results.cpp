@@ -94,8 +94,10 @@ std::string floors_text(const RunGroup& g) {
   for (const MetricsRecord* m : ms) {
     std::string s;
     for (size_t f = 0; f < m->per_floor.size(); ++f)
-      if (m->per_floor[f].traversable_coverage >= kFloorDone)
-        s += (s.empty() ? "" : "+") + std::to_string(f + 1);
+      if (m->per_floor[f].traversable_coverage >= kFloorDone) {
+        if (!s.empty()) s += '+';  // piecewise: GCC 12 warns (-Wrestrict, false positive)
+        s += std::to_string(f + 1);
+      }
     if (s.empty()) s = "none";
     if (!count[s]++) order.push_back(s);
   }

@@ -18,6 +18,17 @@ std::string RunSpec::rel_dir() const {
   return "runs/" + scene_name() + "/" + variant() + "/seed" + std::to_string(seed);
 }
 
+std::string TimeLimits::describe() const {
+  char b[64];
+  std::snprintf(b, sizeof b, "%g s", all_s);
+  std::string s = b;
+  for (const auto& [scene, t] : scene_s) {
+    std::snprintf(b, sizeof b, "%g s", t);
+    s += ", " + scene + " " + b;
+  }
+  return s;
+}
+
 std::vector<std::string> RunSpec::sim_args(double time_limit_s, const std::string& out_dir,
                                            const std::string& config) const {
   char t[32];

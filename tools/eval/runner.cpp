@@ -40,15 +40,14 @@ struct Running {
 };
 
 struct RunningInfo {
-  double elapsed_s, sim_t;
+  double elapsed_s, sim_t, limit_s;
 };
 
 // The progress bar: one line on a terminal (rewritten with '\r'), otherwise one line per run.
 class Progress {
  public:
-  Progress(FILE* out, size_t total, size_t resumed, int jobs, double time_limit_s)
-      : limit_(time_limit_s),
-        out_(out),
+  Progress(FILE* out, size_t total, size_t resumed, int jobs)
+      : out_(out),
         tty_(out && isatty(fileno(out))),
         total_(total),
         resumed_(resumed),
@@ -122,7 +121,7 @@ class Progress {
     size_t paced = 0;
     for (const auto& r : running_) {
       if (r.sim_t < 1.0) continue;
-      const double total = r.elapsed_s * limit_ / r.sim_t;
+      const double total = r.elapsed_s * r.limit_s / r.sim_t;
       work += std::max(0.0, total - r.elapsed_s);
       total_sum += total;
       ++paced;
@@ -132,7 +131,6 @@ class Progress {
     return "<= " + format_duration(work / double(jobs_));
   }
 
-  double limit_;
   FILE* out_;
   bool tty_;
   size_t total_, resumed_;
@@ -189,8 +187,7 @@ std::vector<RunOutcome> Runner::run(const std::vector<RunSpec>& specs) {
     std::fprintf(o_.progress,
                  "storey-eval: %zu of %zu runs already finished (resumed), %zu to run\n",
                  specs.size() - pending.size(), specs.size(), pending.size());
-  Progress progress(o_.progress, specs.size(), specs.size() - pending.size(), o_.jobs,
-                    o_.time_limit_s);
+  Progress progress(o_.progress, specs.size(), specs.size() - pending.size(), o_.jobs);
   // Reads the children's progress lines every 2 s (only for the ETA).
   auto running_info = [&](std::vector<Running>& rs) {
     std::vector<RunningInfo> v;
@@ -199,7 +196,8 @@ std::vector<RunOutcome> Runner::run(const std::vector<RunSpec>& specs) {
         r.polled = Clock::now();
         r.sim_t = last_simulated_time(r.staging + "/log.txt");
       }
-      v.push_back({seconds_since(r.start), r.sim_t});
+      v.push_back({seconds_since(r.start), r.sim_t,
+                   o_.time_limits.for_scene(specs[r.index].scene_name())});
     }
     return v;
   };
@@ -219,7 +217,7 @@ std::vector<RunOutcome> Runner::run(const std::vector<RunSpec>& specs) {
     fs::remove_all(r.staging, ec);
     fs::create_directories(r.staging, ec);
     if (ec) throw std::runtime_error(r.staging + ": cannot create (" + ec.message() + ")");
-    std::vector<std::string> args = spec.sim_args(o_.time_limit_s, r.staging, o_.config);
+    std::vector<std::string> args = spec.sim_args(o_.time_limits.for_scene(spec.scene_name()), r.staging, o_.config);
     args.insert(args.begin(), o_.storey);
     std::vector<char*> argv;
     for (auto& a : args) argv.push_back(a.data());
@@ -279,7 +277,7 @@ std::vector<RunOutcome> Runner::run(const std::vector<RunSpec>& specs) {
                                       " without metrics.json or a message"
                                 : last;
     }
-    std::vector<std::string> cmd = spec.sim_args(o_.time_limit_s, r.final_dir, o_.config);
+    std::vector<std::string> cmd = spec.sim_args(o_.time_limits.for_scene(spec.scene_name()), r.final_dir, o_.config);
     cmd.insert(cmd.begin(), o_.storey);
     write_eval_record(o, r.staging, cmd);
     fs::remove_all(r.final_dir, ec);

@@ -18,7 +18,7 @@ struct RunnerOptions {
   std::string storey;          // the `storey` executable
   int jobs = 1;                // children at once
   std::string out_dir;         // runs go to out_dir/runs/...
-  double time_limit_s = 1800;  // --time-limit of every run
+  TimeLimits time_limits;      // each run's --time-limit, by scene
   std::string config;          // --config of every run ("" = none)
   FILE* progress = stderr;     // progress bar and failure lines; nullptr = quiet
 };
