@@ -83,9 +83,9 @@ TEST(Runner, RunsEverySpecAndRecordsFailuresWithTheirReason) {
     std::ifstream log(dir + "/log.txt");
     std::stringstream ss;
     ss << log.rdbuf();
-    EXPECT_NE(ss.str().find("storey sim: scene x, seed " + std::to_string(i + 1) +
-                            ", time limit 30"),
-              std::string::npos);
+    EXPECT_NE(
+        ss.str().find("storey sim: scene x, seed " + std::to_string(i + 1) + ", time limit 30"),
+        std::string::npos);
     EXPECT_TRUE(fs::exists(dir + "/eval.json"));
     EXPECT_FALSE(fs::exists(dir + ".partial"));
   }
@@ -166,7 +166,8 @@ TEST(Runner, ASignalledOrMissingChildIsAFailedRunNotAnAbort) {
   EXPECT_EQ(res[1].status, RunStatus::finished);
 
   const auto missing =
-      Runner({fake.dir + "/no-such-storey", 1, out + "2", TimeLimits{30, {}}, "", nullptr}).run(specs);
+      Runner({fake.dir + "/no-such-storey", 1, out + "2", TimeLimits{30, {}}, "", nullptr})
+          .run(specs);
   EXPECT_EQ(missing[0].status, RunStatus::failed);
   EXPECT_NE(missing[0].reason.find("no-such-storey"), std::string::npos) << missing[0].reason;
 }

@@ -196,8 +196,8 @@ std::vector<RunOutcome> Runner::run(const std::vector<RunSpec>& specs) {
         r.polled = Clock::now();
         r.sim_t = last_simulated_time(r.staging + "/log.txt");
       }
-      v.push_back({seconds_since(r.start), r.sim_t,
-                   o_.time_limits.for_scene(specs[r.index].scene_name())});
+      v.push_back(
+          {seconds_since(r.start), r.sim_t, o_.time_limits.for_scene(specs[r.index].scene_name())});
     }
     return v;
   };
@@ -217,7 +217,8 @@ std::vector<RunOutcome> Runner::run(const std::vector<RunSpec>& specs) {
     fs::remove_all(r.staging, ec);
     fs::create_directories(r.staging, ec);
     if (ec) throw std::runtime_error(r.staging + ": cannot create (" + ec.message() + ")");
-    std::vector<std::string> args = spec.sim_args(o_.time_limits.for_scene(spec.scene_name()), r.staging, o_.config);
+    std::vector<std::string> args =
+        spec.sim_args(o_.time_limits.for_scene(spec.scene_name()), r.staging, o_.config);
     args.insert(args.begin(), o_.storey);
     std::vector<char*> argv;
     for (auto& a : args) argv.push_back(a.data());
@@ -277,7 +278,8 @@ std::vector<RunOutcome> Runner::run(const std::vector<RunSpec>& specs) {
                                       " without metrics.json or a message"
                                 : last;
     }
-    std::vector<std::string> cmd = spec.sim_args(o_.time_limits.for_scene(spec.scene_name()), r.final_dir, o_.config);
+    std::vector<std::string> cmd =
+        spec.sim_args(o_.time_limits.for_scene(spec.scene_name()), r.final_dir, o_.config);
     cmd.insert(cmd.begin(), o_.storey);
     write_eval_record(o, r.staging, cmd);
     fs::remove_all(r.final_dir, ec);

@@ -15,12 +15,12 @@
 namespace storey::tools::eval {
 
 struct RunnerOptions {
-  std::string storey;          // the `storey` executable
-  int jobs = 1;                // children at once
-  std::string out_dir;         // runs go to out_dir/runs/...
-  TimeLimits time_limits;      // each run's --time-limit, by scene
-  std::string config;          // --config of every run ("" = none)
-  FILE* progress = stderr;     // progress bar and failure lines; nullptr = quiet
+  std::string storey;       // the `storey` executable
+  int jobs = 1;             // children at once
+  std::string out_dir;      // runs go to out_dir/runs/...
+  TimeLimits time_limits;   // each run's --time-limit, by scene
+  std::string config;       // --config of every run ("" = none)
+  FILE* progress = stderr;  // progress bar and failure lines; nullptr = quiet
 };
 
 class Runner {
