@@ -245,6 +245,24 @@ TEST(Results, MarkdownTablesShapedLikeThePapers) {
   EXPECT_NE(md.find("| two | fael-like | 1 of 3 | killed by signal 9 |"), std::string::npos);
 }
 
+TEST(Results, FootnoteNamesTheTimeLimitsTheRunsHad) {
+  Fixture fx;
+  // The fixture's runs carry no eval.json command: no line.
+  EXPECT_EQ(results_markdown({fx.outcomes, "x", {}}).find("Time limits"), std::string::npos);
+  std::vector<RunOutcome> o = fx.outcomes;
+  for (auto& r : o) r.time_limit_s = 1800;
+  o[0].time_limit_s = 3000;  // two/storey mixed; failed runs (two/tare-like) are not counted
+  for (auto& r : o)
+    if (r.spec.scene == "maze" && r.spec.ablation == "no-prior") r.time_limit_s = 900;
+  for (auto& r : o)
+    if (r.spec.method == "tare-like") r.time_limit_s = 60;
+  EXPECT_NE(results_markdown({o, "x", {}})
+                .find("Time limits (each run's --time-limit): 1800 s; two/storey 1800/3000 s; "
+                      "maze/storey-no-prior 900 s."),
+            std::string::npos)
+      << results_markdown({o, "x", {}});
+}
+
 TEST(Results, CsvHasOneRowPerRunAndJsonParses) {
   Fixture fx;
   const std::string csv = results_csv(fx.outcomes);

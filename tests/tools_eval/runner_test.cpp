@@ -117,6 +117,9 @@ TEST(Runner, EachSceneRunsWithItsOwnTimeLimit) {
   EXPECT_NE(log_of(out + "/" + specs[0].rel_dir()).find("time limit 30\n"), std::string::npos);
   // Keyed by the folder name (the file's stem), as the tables name the scene.
   EXPECT_NE(log_of(out + "/" + specs[1].rel_dir()).find("time limit 45.5\n"), std::string::npos);
+  // And the records say so (eval.json's command), for the tables' footnote.
+  EXPECT_DOUBLE_EQ(res[0].time_limit_s, 30);
+  EXPECT_DOUBLE_EQ(load_outcome(specs[1], out + "/" + specs[1].rel_dir()).time_limit_s, 45.5);
 }
 
 TEST(Runner, ResumesFinishedRunsAndRetriesFailedAndBrokenOnes) {

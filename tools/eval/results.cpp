@@ -131,6 +131,43 @@ std::string end_text(const RunGroup& g) {
   return s.empty() ? "n/a" : s;
 }
 
+// "Time limits: 1800 s; teaching_building/storey 3000 s." from each finished run's --time-limit:
+// the most common value first, then the scene/variant rows whose runs had another (several:
+// "1800/3000 s"). "" when no run recorded one.
+std::string time_limits_text(const std::vector<RunOutcome>& outcomes) {
+  std::map<double, size_t> count;
+  std::vector<std::string> rows;                      // scene/variant, in first-seen order
+  std::map<std::string, std::vector<double>> limits;  // per row, sorted, distinct
+  for (const RunOutcome& r : outcomes) {
+    if (r.status != RunStatus::finished || !std::isfinite(r.time_limit_s)) continue;
+    ++count[r.time_limit_s];
+    const std::string row = r.spec.scene_name() + "/" + r.spec.variant();
+    auto [it, fresh] = limits.try_emplace(row);
+    if (fresh) rows.push_back(row);
+    auto& v = it->second;
+    if (std::find(v.begin(), v.end(), r.time_limit_s) == v.end()) {
+      v.push_back(r.time_limit_s);
+      std::sort(v.begin(), v.end());
+    }
+  }
+  if (count.empty()) return "";
+  double common = count.begin()->first;
+  for (const auto& [t, n] : count)
+    if (n > count[common]) common = t;
+  std::string s = "Time limits (each run's --time-limit): " + fmt("%g", common) + " s";
+  for (const auto& row : rows) {
+    const auto& v = limits[row];
+    if (v.size() == 1 && v[0] == common) continue;
+    s += "; " + row + " ";
+    for (size_t i = 0; i < v.size(); ++i) {
+      if (i) s += '/';
+      s += fmt("%g", v[i]);
+    }
+    s += " s";
+  }
+  return s + ".";
+}
+
 std::string safety_text(const RunGroup& g) {
   const auto ms = finished_metrics(g);
   if (ms.empty()) return "n/a";
@@ -315,6 +352,7 @@ std::string results_markdown(const ResultsInput& in) {
     for (size_t i = 0; i < truth_notes.size(); ++i) md << (i ? ";" : "") << " " << truth_notes[i];
     md << ".";
   }
+  if (const std::string t = time_limits_text(in.outcomes); !t.empty()) md << " " << t;
   md << "\n\n";
 
   // Table II: per-floor statistics of the proposed method.

@@ -66,11 +66,12 @@ const char* to_string(RunStatus s);
 struct RunOutcome {
   RunSpec spec;
   RunStatus status = RunStatus::not_run;
-  bool resumed = false;   // finished in an earlier storey-eval invocation
-  int exit_code = -1;     // the child's exit code; -1 when unknown (killed, or not recorded)
-  std::string reason;     // failed: why (the child's last stderr line); finished: end reason
-  double wall_s = 0.0;    // wall-clock seconds the child took (0 when unknown)
-  MetricsRecord metrics;  // valid when status == finished
+  bool resumed = false;  // finished in an earlier storey-eval invocation
+  int exit_code = -1;    // the child's exit code; -1 when unknown (killed, or not recorded)
+  std::string reason;    // failed: why (the child's last stderr line); finished: end reason
+  double wall_s = 0.0;   // wall-clock seconds the child took (0 when unknown)
+  double time_limit_s = std::nan("");  // the run's --time-limit, from eval.json's command
+  MetricsRecord metrics;               // valid when status == finished
 };
 
 // Reads a run folder (DIR/runs/...): finished when metrics.json is complete; failed when the
