@@ -259,6 +259,8 @@ void read_safety(SectionReader&& r, SafetyConfig& o) {
   r.get("lookahead_s", o.lookahead_s, Range{0.1, 10.0});
   r.get("max_overruns", o.max_overruns, Range{1, 1000});
   r.get("turn_on_reference", o.turn_on_reference);
+  r.get("turn_on_reference_full_m", o.turn_on_reference_full_m, Range{0.0, 2.0});
+  r.get("turn_on_reference_zero_m", o.turn_on_reference_zero_m, Range{0.01, 2.0});
   r.get("lookahead_on_plan_grid", o.lookahead_on_plan_grid);
   r.get("reference_yaw_gate_rad", o.reference_yaw_gate_rad, Range{0.05, 3.0});
   r.get("reference_speed_lead_mps", o.reference_speed_lead_mps, Range{0.0, 5.0});
@@ -354,6 +356,8 @@ void cross_check(const Parameters& p, ReadContext& ctx, const std::string& top) 
   c.greater(p.robot.body_height_m, "robot.body_height_m", p.robot.step_height_m,
             "robot.step_height_m");
   c.greater(p.map.max_range_m, "map.max_range_m", p.map.min_range_m, "map.min_range_m");
+  c.greater(p.safety.turn_on_reference_zero_m, "safety.turn_on_reference_zero_m",
+            p.safety.turn_on_reference_full_m, "safety.turn_on_reference_full_m");
   c.greater(p.map.log_odds_max, "map.log_odds_max", p.map.log_odds_occupied,
             "map.log_odds_occupied");
   c.greater(p.map.log_odds_occupied, "map.log_odds_occupied", p.map.log_odds_min,

@@ -82,6 +82,12 @@ struct SafetyConfig {
   // (ControlLaw::yaw_gate): a robot overshooting a new trajectory's start turned its body into a
   // door frame.
   bool turn_on_reference = false;
+  // ... "on the reference": the rest point within the first distance of the reference's gives
+  // full yaw authority, falling to none at the second (ControlLaw::on_reference) [m]. A body
+  // 0.15-0.23 m past a turn-in-place start turned into a wall with 0.15 / 0.3 (office
+  // nearest-frontier seed 5, sessions 42-43).
+  double turn_on_reference_full_m = 0.15;
+  double turn_on_reference_zero_m = 0.3;
   // The look-ahead samples the poses of the planner's own check (check_on_grid) and asks for a
   // replan on every new trajectory it finds colliding: sampled from tau, it failed a pose the
   // planner passed, and the robot stood stopped on a kept trajectory for 400 s (house seed 6).

@@ -48,6 +48,13 @@ AutonomyOptions widen_for_blind_zone(AutonomyOptions o) {
   return o;
 }
 
+ControlGains gains_of(const config::SafetyConfig& s) {
+  ControlGains g;
+  g.on_reference_full_m = s.turn_on_reference_full_m;
+  g.on_reference_zero_m = s.turn_on_reference_zero_m;
+  return g;
+}
+
 core::plan::BodyPose pose_on(const core::plan::BsplineTrajectory& t, double tau) {
   return t.pose(std::clamp(tau, t.t_start(), t.t_end()));
 }
@@ -69,7 +76,7 @@ Autonomy::Autonomy(Platform& platform, const rt::Clock& clock, AutonomyOptions o
       rng_(opt_.seed),
       policy_(make_exploration_policy(opt_.method, opt_.params)),
       plan_q_(64),
-      law_(opt_.params.robot),
+      law_(opt_.params.robot, gains_of(opt_.params.safety)),
       safety_(opt_.params.safety),
       lookahead_(opt_.params.robot, opt_.params.map.voxel_size_m),
       stop_q_(256) {

@@ -100,7 +100,7 @@ double ramp_down(double d, double full_m, double zero_m) {
 
 double ControlLaw::on_reference(const core::plan::TrajectorySample& ref,
                                 const PoseSample& pose) const {
-  return ramp_down(braking_gap(ref, pose), 0.15, 0.3);
+  return ramp_down(braking_gap(ref, pose), gains_.on_reference_full_m, gains_.on_reference_zero_m);
 }
 
 double ControlLaw::on_path(const core::plan::BsplineTrajectory& t, double from_s, double to_s,

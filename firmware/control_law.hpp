@@ -14,6 +14,10 @@ namespace storey::firmware {
 struct ControlGains {
   double k_position = 1.2;  // [1/s] position error -> world velocity correction
   double k_yaw = 2.0;       // [1/s] yaw error -> yaw rate correction
+  // on_reference(): full yaw authority within the first, none from the second [m]
+  // (safety.turn_on_reference_full_m / _zero_m).
+  double on_reference_full_m = 0.15;
+  double on_reference_zero_m = 0.3;
 };
 
 class ControlLaw {
@@ -35,10 +39,11 @@ class ControlLaw {
   double yaw_gate(const core::plan::BsplineTrajectory& t, double entry_tau, double tau,
                   const core::plan::TrajectorySample& ref, const PoseSample& pose) const;
   // 1 while the point where the robot would stop if it braked now is within 0.15 m of the
-  // reference's, falling to 0 at 0.3 m. A new trajectory starts at rest where the robot was when
-  // it was planned; a robot arriving at walking speed overshoots that start by up to
-  // v^2 / (2 a_max) (0.5 m at 1 m/s) before it is back, and turning the 0.7 m body there, off
-  // the poses FCL checked, swept it into a door frame (teaching_building seed 1, 842 s).
+  // reference's, falling to 0 at 0.3 m (ControlGains::on_reference_full_m / _zero_m). A new
+  // trajectory starts at rest where the robot was when it was planned; a robot arriving at walking
+  // speed overshoots that start by up to v^2 / (2 a_max) (0.5 m at 1 m/s) before it is back, and
+  // turning the 0.7 m body there, off the poses FCL checked, swept it into a door frame
+  // (teaching_building seed 1, 842 s).
   double on_reference(const core::plan::TrajectorySample& ref, const PoseSample& pose) const;
   // 1 while the robot's rest point is within kOnPathFullM of t's path between from_s and to_s
   // (sampled every kPathStepS), falling to 0 at kOnPathZeroM. A body entering a trajectory

@@ -255,6 +255,17 @@ TEST(ConfigErrors, CrossFieldNamesTheKeyTheUserWrote) {
             "task period of 20000 us (50 Hz)");
 }
 
+TEST(ConfigErrors, TurnOnReferenceRampMustFall) {
+  const Result r = load_string(
+      "safety:\n  turn_on_reference_full_m: 0.2\n  turn_on_reference_zero_m: 0.1\n"
+      "sensor:\n  type: vlp16\nlink:\n  transport: sim\n",
+      "t.yaml");
+  ASSERT_EQ(messages(r).size(), 1u) << joined(r);
+  EXPECT_EQ(messages(r)[0],
+            "t.yaml:3: safety.turn_on_reference_zero_m: safety.turn_on_reference_zero_m = 0.1 "
+            "must be greater than safety.turn_on_reference_full_m = 0.2");
+}
+
 TEST(ConfigErrors, CrossFieldUdpPortClash) {
   const Result r = load_string(
       "sensor:\n  type: vlp16\n  data_port: 17002\n"

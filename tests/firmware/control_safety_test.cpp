@@ -91,6 +91,25 @@ TEST(ControlLaw, TurnsOnlyWhereItWillComeToRestOnTheReference) {
   EXPECT_GT(law.track(start, lagging, VelocityCommand{}, dt).yaw_rate_rps, 0.0);
 }
 
+// safety.turn_on_reference_full_m / _zero_m set on_reference's ramp: a rest point 0.2 m from the
+// reference's has 2/3 of full yaw with the defaults (0.15 / 0.3), none with 0.05 / 0.15.
+TEST(ControlLaw, OnReferenceRampFromTheGains) {
+  core::RobotModel robot;
+  const auto ref = ref_at(0, 0, 0, 0, 1.5);
+  PoseSample pose;
+  pose.x_m = 0.2;  // at rest, 0.2 m past a turn-in-place start
+  EXPECT_NEAR(ControlLaw(robot).on_reference(ref, pose), 2.0 / 3.0, 1e-9);
+  ControlGains tight;
+  tight.on_reference_full_m = 0.05;
+  tight.on_reference_zero_m = 0.15;
+  const ControlLaw law(robot, tight);
+  EXPECT_EQ(law.on_reference(ref, pose), 0.0);
+  pose.x_m = 0.1;
+  EXPECT_NEAR(law.on_reference(ref, pose), 0.5, 1e-9);
+  pose.x_m = 0.04;
+  EXPECT_EQ(law.on_reference(ref, pose), 1.0);
+}
+
 // A body entering a trajectory mid-way from rest (ControlLaw::entry_time) lags a reference at
 // walking speed and never comes to rest at it: on_reference alone held its yaw 16 deg off the
 // path's until it met a jamb (office, nearest-frontier seed 5, 184 s). Where it rests on the path
