@@ -60,6 +60,10 @@ TEST(EvalOptions, TimeLimitsPerScene) {
   ASSERT_TRUE(k.ok()) << k.error;
   EXPECT_DOUBLE_EQ(k.options.time_limits.for_scene("teaching_building"), 3000);
   EXPECT_DOUBLE_EQ(k.options.time_limits.for_scene("house"), 1800);
+  // The error lists the matrix's scenes once each (the paper preset has maze in two groups).
+  EXPECT_EQ(parse({"--preset", "paper", "--time-limit", "mze=5"}).error,
+            "--time-limit: scene 'mze' is not in the matrix (scenes: office, maze, "
+            "teaching_building, house)");
   // A scene file is named by its stem, as in the run folders.
   EXPECT_TRUE(parse({"--scenes", "x/hall.yaml", "--time-limit", "hall=5"}).ok());
 }

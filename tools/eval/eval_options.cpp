@@ -212,17 +212,17 @@ ParseResult parse_eval_args(const std::vector<std::string>& args) {
   // A limit for a scene the matrix does not run is a typo that would pass silently.
   for (const auto& name : limit_scenes) {
     bool found = false;
-    std::string known;
+    std::string known = ", ";
     for (const auto& g : o.groups)
       for (const auto& s : g.scenes) {
         const std::string stem = RunSpec{s, "", "", 1}.scene_name();
         found = found || stem == name;
-        if (!known.empty()) known += ", ";
-        known += stem;
+        if (known.find(", " + stem + ",") != std::string::npos) continue;  // maze in two groups
+        known += stem + ", ";
       }
     if (!found)
-      return fail("--time-limit: scene '" + name + "' is not in the matrix (scenes: " + known +
-                  ")");
+      return fail("--time-limit: scene '" + name +
+                  "' is not in the matrix (scenes: " + known.substr(2, known.size() - 4) + ")");
   }
   return r;
 }

@@ -20,7 +20,7 @@ struct TimeLimits {
     const auto it = scene_s.find(scene_name);
     return it == scene_s.end() ? all_s : it->second;
   }
-  // "1800, teaching_building 3000 s"
+  // "1800 s, teaching_building 3000 s"
   std::string describe() const;
 };
 
