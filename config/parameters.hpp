@@ -85,7 +85,8 @@ struct SafetyConfig {
   // ... "on the reference": the rest point within the first distance of the reference's gives
   // full yaw authority, falling to none at the second (ControlLaw::on_reference) [m]. A body
   // 0.15-0.23 m past a turn-in-place start turned into a wall with 0.15 / 0.3 (office
-  // nearest-frontier seed 5, sessions 42-43).
+  // nearest-frontier seed 5, sessions 42-43); 0.05 / 0.15 held another body's yaw while its
+  // reference turned, into a wall (seed 1, session 44).
   double turn_on_reference_full_m = 0.15;
   double turn_on_reference_zero_m = 0.3;
   // The look-ahead samples the poses of the planner's own check (check_on_grid) and asks for a
