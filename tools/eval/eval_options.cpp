@@ -65,12 +65,6 @@ std::vector<std::string> split_list(const std::string& v) {
   return out;
 }
 
-bool parse_seconds(const std::string& s, double& out) {
-  char* end = nullptr;
-  out = std::strtod(s.c_str(), &end);
-  return !s.empty() && end && *end == '\0' && std::isfinite(out) && out > 0;
-}
-
 bool parse_uint(const std::string& s, uint64_t& out) {
   if (s.empty() || s.size() > 18 || !std::all_of(s.begin(), s.end(), ::isdigit)) return false;
   out = std::strtoull(s.c_str(), nullptr, 10);

@@ -1,7 +1,9 @@
 #include "tools/eval/run_matrix.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 
 namespace storey::tools::eval {
 
@@ -16,6 +18,12 @@ std::string RunSpec::scene_name() const {
 
 std::string RunSpec::rel_dir() const {
   return "runs/" + scene_name() + "/" + variant() + "/seed" + std::to_string(seed);
+}
+
+bool parse_seconds(const std::string& s, double& out) {
+  char* end = nullptr;
+  out = std::strtod(s.c_str(), &end);
+  return !s.empty() && end && *end == '\0' && std::isfinite(out) && out > 0;
 }
 
 std::string TimeLimits::describe() const {

@@ -23,6 +23,8 @@ struct TimeLimits {
   // "1800 s, teaching_building 3000 s"
   std::string describe() const;
 };
+// A --time-limit value: the whole string a finite number of seconds > 0.
+bool parse_seconds(const std::string& s, double& out);
 
 // One block of the matrix. "full" in `ablations` means the method without --ablation.
 struct MatrixGroup {

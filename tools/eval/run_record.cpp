@@ -188,11 +188,9 @@ RunOutcome load_outcome(const RunSpec& spec, const std::string& dir) {
     if (const JsonValue* c = ev.find("command"); c && c->is_array()) {
       const auto& a = c->array();
       for (size_t i = 0; i + 1 < a.size(); ++i)
-        if (a[i].is_string() && a[i].string() == "--time-limit" && a[i + 1].is_string()) {
-          char* end = nullptr;
-          const double t = std::strtod(a[i + 1].string().c_str(), &end);
-          if (end && *end == '\0' && std::isfinite(t) && t > 0) o.time_limit_s = t;
-        }
+        if (double t = 0; a[i].is_string() && a[i].string() == "--time-limit" &&
+                          a[i + 1].is_string() && parse_seconds(a[i + 1].string(), t))
+          o.time_limit_s = t;
     }
   }
   std::string err;
